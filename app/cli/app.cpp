@@ -1,0 +1,90 @@
+#include "cli/app.hpp"
+
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "odometry/error.hpp"
+
+namespace gvio::cli {
+namespace {
+
+void setupLogging(const CommonOptions& common) {
+  auto logger = spdlog::stderr_color_mt("gvio");
+  logger->set_pattern("%^[%l]%$ %v");
+  spdlog::level::level_enum level = spdlog::level::info;
+  if (common.verbose >= 2)
+    level = spdlog::level::trace;
+  else if (common.verbose == 1)
+    level = spdlog::level::debug;
+  if (common.quiet >= 2)
+    level = spdlog::level::err;
+  else if (common.quiet == 1)
+    level = spdlog::level::warn;
+  logger->set_level(level);
+  spdlog::set_default_logger(logger);
+}
+
+// Bad input is the user's to fix (exit 2, one line); anything else is our bug (exit 1).
+int runGuarded(const std::function<int()>& run) {
+  try {
+    return run();
+  } catch (const InvalidInput& e) {
+    spdlog::error("{}", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    spdlog::error("internal error: {}", e.what());
+    return 1;
+  }
+}
+
+}  // namespace
+
+ProgressStyle CommonOptions::progressStyle() const {
+  return chooseProgressStyle(!no_progress && quiet == 0, stderr);
+}
+
+void ConfigOptions::addTo(CLI::App& sub) {
+  sub.add_option("--config", file, "YAML configuration (see assets/config/default.yaml)");
+  sub.add_option("--set", overrides,
+                 "Override one config key: --set dataset.gap_factor=3 (repeatable)")
+      ->take_all()
+      ->allow_extra_args(false);
+}
+
+AppConfig ConfigOptions::load() const {
+  ConfigSources sources;
+  if (file) sources.file = *file;
+  sources.overrides = overrides;
+  return loadConfig(sources);
+}
+
+int runMain(int argc, char** argv) {
+  CLI::App app{"gvio: GNSS-assisted visual-inertial odometry, georeferenced maps and evaluation",
+               "gvio"};
+  app.set_version_flag("--version", std::string(GVIO_VERSION));
+  CommonOptions common;
+  app.add_flag("-v,--verbose", common.verbose, "More log output (-vv: trace)");
+  app.add_flag("-q,--quiet", common.quiet,
+               "Warnings and errors only (-qq: errors only), no progress");
+  app.add_flag("--no-progress", common.no_progress, "No progress bar or progress lines on stderr");
+  app.fallthrough();
+  app.require_subcommand(1);
+  app.footer("Exit codes: 0 success, 2 bad usage or bad input, 1 internal error.");
+
+  // Each subcommand is registered here only once it really works.
+  std::vector<Command> commands;
+  commands.push_back(addInspectCommand(app, common));
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  setupLogging(common);
+  for (const auto& command : commands) {
+    if (command.app->parsed()) return runGuarded(command.run);
+  }
+  return 2;
+}
+
+}  // namespace gvio::cli

@@ -1,0 +1,42 @@
+#pragma once
+// The gvio command line: global flags, subcommand registration, exit codes
+// (0 ok, 2 bad usage or bad input, 1 internal error).
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/config.hpp"
+#include "cli/progress.hpp"
+
+namespace gvio::cli {
+
+struct CommonOptions {
+  int verbose = 0;
+  int quiet = 0;
+  bool no_progress = false;
+
+  [[nodiscard]] ProgressStyle progressStyle() const;
+};
+
+// --config FILE and --set key=value, on the subcommands that take configuration.
+struct ConfigOptions {
+  std::optional<std::string> file;
+  std::vector<std::string> overrides;
+
+  void addTo(CLI::App& sub);
+  [[nodiscard]] AppConfig load() const;
+};
+
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+Command addInspectCommand(CLI::App& app, const CommonOptions& common);
+
+int runMain(int argc, char** argv);
+
+}  // namespace gvio::cli

@@ -1,0 +1,172 @@
+#include "cli/config.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+#include <yaml-cpp/yaml.h>
+
+#include <charconv>
+#include <cmath>
+#include <map>
+
+#include "io/input_error.hpp"
+
+namespace gvio::cli {
+namespace {
+
+double parseDouble(std::string_view key, std::string_view text) {
+  double value = 0.0;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || ec != std::errc() || ptr != text.data() + text.size() ||
+      !std::isfinite(value)) {
+    throw InvalidInput(fmt::format("bad value '{}' for {}: expected a finite number", text, key));
+  }
+  return value;
+}
+
+bool parseBool(std::string_view key, std::string_view text) {
+  if (text == "true" || text == "yes" || text == "on" || text == "1") return true;
+  if (text == "false" || text == "no" || text == "off" || text == "0") return false;
+  throw InvalidInput(fmt::format("bad value '{}' for {}: expected true or false", text, key));
+}
+
+std::string formatDouble(double v) {
+  return fmt::format("{}", v);
+}  // shortest round-trip form
+
+ConfigKey number(std::string name, double& field) {
+  return {name, [name, &field](std::string_view v) { field = parseDouble(name, v); },
+          [&field] { return formatDouble(field); }};
+}
+
+ConfigKey boolean(std::string name, bool& field) {
+  return {name, [name, &field](std::string_view v) { field = parseBool(name, v); },
+          [&field] { return std::string(field ? "true" : "false"); }};
+}
+
+ConfigKey text(std::string name, std::string& field) {
+  return {name, [&field](std::string_view v) { field = std::string(v); },
+          [&field] { return field; }};
+}
+
+struct FlatEntry {
+  std::string value;
+  std::size_t line = 0;
+};
+
+// Nested YAML maps become dotted keys; sequences are joined with ',' (vectors parse that form).
+void flatten(const YAML::Node& node, const std::string& prefix,
+             std::vector<std::pair<std::string, FlatEntry>>& out,
+             const std::filesystem::path& file) {
+  const auto line = static_cast<std::size_t>(node.Mark().line + 1);
+  if (node.IsMap()) {
+    for (const auto& kv : node) {
+      const std::string key = kv.first.Scalar();
+      flatten(kv.second, prefix.empty() ? key : prefix + "." + key, out, file);
+    }
+  } else if (node.IsSequence()) {
+    std::string joined;
+    for (const auto& item : node) joined += (joined.empty() ? "" : ",") + item.Scalar();
+    out.emplace_back(prefix, FlatEntry{joined, line});
+  } else if (node.IsScalar()) {
+    out.emplace_back(prefix, FlatEntry{node.Scalar(), line});
+  } else if (!prefix.empty()) {
+    throw io::InputError(file, line, "key '" + prefix + "' has no value");
+  }
+}
+
+void applyFile(const std::filesystem::path& file, std::map<std::string, ConfigKey*>& keys,
+               std::vector<std::string>* unknown_keys) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(file.string());
+  } catch (const YAML::BadFile&) {
+    throw io::InputError(file, 0, "config file not found or unreadable");
+  } catch (const YAML::Exception& e) {
+    throw io::InputError(file, static_cast<std::size_t>(e.mark.line + 1), "YAML syntax: " + e.msg);
+  }
+  if (root.IsNull()) return;  // an empty file keeps the defaults
+  if (!root.IsMap()) throw io::InputError(file, 1, "expected a mapping of config keys");
+  std::vector<std::pair<std::string, FlatEntry>> entries;
+  flatten(root, "", entries, file);
+  for (const auto& [key, entry] : entries) {
+    const auto it = keys.find(key);
+    if (it == keys.end()) {
+      spdlog::warn("{}:{}: unknown config key '{}' ignored", file.string(), entry.line, key);
+      if (unknown_keys) unknown_keys->push_back(key);
+      continue;
+    }
+    try {
+      it->second->set(entry.value);
+    } catch (const InvalidInput& e) {
+      throw io::InputError(file, entry.line, e.what());
+    }
+  }
+}
+
+void applyOverride(const std::string& assignment, std::map<std::string, ConfigKey*>& keys) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw InvalidInput("--set '" + assignment + "': expected key=value");
+  }
+  const std::string key = assignment.substr(0, eq);
+  const auto it = keys.find(key);
+  if (it == keys.end()) throw InvalidInput("--set: unknown config key '" + key + "'");
+  it->second->set(std::string_view(assignment).substr(eq + 1));
+}
+
+}  // namespace
+
+void AppConfig::validate() const {
+  dataset.validate();
+  imu.noise.validate();
+}
+
+std::vector<ConfigKey> configKeys(AppConfig& c) {
+  return {
+      text("dataset.kitti_gnss_source", c.dataset.kitti_gnss_source),
+      number("dataset.gap_factor", c.dataset.gap_factor),
+      number("dataset.nmea_uere_spp_m", c.dataset.nmea_uere_spp_m),
+      number("dataset.nmea_uere_dgps_m", c.dataset.nmea_uere_dgps_m),
+      number("dataset.nmea_uere_rtk_float_m", c.dataset.nmea_uere_rtk_float_m),
+      number("dataset.nmea_uere_rtk_fixed_m", c.dataset.nmea_uere_rtk_fixed_m),
+      number("dataset.nmea_vertical_factor", c.dataset.nmea_vertical_factor),
+      boolean("imu.prefer_dataset_noise", c.imu.prefer_dataset_noise),
+      number("imu.acc_noise_density", c.imu.noise.acc_noise_density),
+      number("imu.gyr_noise_density", c.imu.noise.gyr_noise_density),
+      number("imu.acc_random_walk", c.imu.noise.acc_random_walk),
+      number("imu.gyr_random_walk", c.imu.noise.gyr_random_walk),
+  };
+}
+
+AppConfig loadConfig(const ConfigSources& sources, std::vector<std::string>* unknown_keys) {
+  AppConfig config;
+  auto keys = configKeys(config);
+  std::map<std::string, ConfigKey*> by_name;
+  for (auto& k : keys) by_name[k.name] = &k;
+  if (sources.file) applyFile(*sources.file, by_name, unknown_keys);
+  for (const auto& assignment : sources.overrides) applyOverride(assignment, by_name);
+  config.validate();
+  return config;
+}
+
+std::string dumpConfigYaml(const AppConfig& config) {
+  AppConfig copy = config;  // configKeys binds mutable references
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+  std::string section;
+  for (const auto& key : configKeys(copy)) {
+    const auto dot = key.name.find('.');
+    const std::string head = key.name.substr(0, dot);
+    if (head != section) {
+      if (!section.empty()) out << YAML::EndMap;
+      out << YAML::Key << head << YAML::Value << YAML::BeginMap;
+      section = head;
+    }
+    out << YAML::Key << key.name.substr(dot + 1) << YAML::Value << key.get();
+  }
+  if (!section.empty()) out << YAML::EndMap;
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace gvio::cli

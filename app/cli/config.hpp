@@ -1,0 +1,52 @@
+#pragma once
+// The application's configuration: plain structs of the libraries and readers, bound to dotted
+// YAML keys ("dataset.gap_factor") by one schema that serves the YAML file, --set and the dump.
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "io/reader_config.hpp"
+#include "odometry/measurements.hpp"
+
+namespace gvio::cli {
+
+struct ImuConfig {
+  // Used when the dataset states its own noise (EuRoC imu0/sensor.yaml) unless false.
+  bool prefer_dataset_noise = true;
+  ImuNoise noise;
+};
+
+struct AppConfig {
+  io::ReaderConfig dataset;
+  ImuConfig imu;
+
+  void validate() const;  // throws InvalidInput naming the key
+};
+
+struct ConfigKey {
+  std::string name;                           // dotted, e.g. "imu.acc_noise_density"
+  std::function<void(std::string_view)> set;  // throws InvalidInput on a bad value
+  std::function<std::string()> get;           // current value as YAML text
+};
+
+// Every configurable key of `config`, bound to its fields.
+std::vector<ConfigKey> configKeys(AppConfig& config);
+
+struct ConfigSources {
+  std::optional<std::filesystem::path> file;  // --config
+  std::vector<std::string> overrides;         // --set key=value, applied after the file
+};
+
+// Defaults, then the YAML file (unknown keys warn with file:line), then the overrides (an unknown
+// key is an error there: it was typed on purpose), then validate(). Throws InvalidInput/InputError.
+// Unknown file keys are appended to `unknown_keys` when given.
+AppConfig loadConfig(const ConfigSources& sources,
+                     std::vector<std::string>* unknown_keys = nullptr);
+
+// The effective configuration as YAML, every key with its value (reproducible runs).
+std::string dumpConfigYaml(const AppConfig& config);
+
+}  // namespace gvio::cli

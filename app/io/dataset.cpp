@@ -1,0 +1,96 @@
+#include "io/dataset.hpp"
+
+#include <fstream>
+
+#include "io/euroc.hpp"
+#include "io/input_error.hpp"
+#include "io/kitti_raw.hpp"
+#include "io/nmea.hpp"
+
+namespace gvio::io {
+namespace fs = std::filesystem;
+namespace {
+
+bool looksLikeNmeaFile(const fs::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  for (int i = 0; i < 20 && std::getline(in, line); ++i) {
+    if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
+    if (line.rfind("$", 0) == 0) return true;
+  }
+  return false;
+}
+
+Dataset readNmeaDataset(const fs::path& file, const ReaderConfig& config) {
+  NmeaLog log = readNmea(file, config);
+  Dataset ds;
+  ds.format = DatasetFormat::kNmea;
+  ds.root = file;
+  ds.variant = "nmea0183";
+  ds.gnss = std::move(log.fixes);
+  ds.gnss_source = file.string();
+  ds.warnings = std::move(log.warnings);
+  return ds;
+}
+
+}  // namespace
+
+std::string toString(DatasetFormat format) {
+  switch (format) {
+    case DatasetFormat::kKittiRaw:
+      return "kitti-raw";
+    case DatasetFormat::kEuroc:
+      return "euroc";
+    case DatasetFormat::kNmea:
+      return "nmea";
+  }
+  return "unknown";
+}
+
+std::optional<DatasetFormat> parseDatasetFormat(const std::string& name) {
+  if (name == "auto") return std::nullopt;
+  if (name == "kitti-raw") return DatasetFormat::kKittiRaw;
+  if (name == "euroc") return DatasetFormat::kEuroc;
+  if (name == "nmea") return DatasetFormat::kNmea;
+  throw InvalidInput("unknown dataset format '" + name +
+                     "' (expected auto, kitti-raw, euroc or nmea)");
+}
+
+DatasetFormat detectFormat(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw InputError(path, 0, "dataset not found");
+  if (fs::is_regular_file(path, ec)) {
+    if (looksLikeNmeaFile(path)) return DatasetFormat::kNmea;
+    throw InputError(path, 0, "a file that is not an NMEA 0183 log (expected a dataset folder)");
+  }
+  if (looksLikeKittiRaw(path)) return DatasetFormat::kKittiRaw;
+  if (!findEurocMav0(path).empty()) return DatasetFormat::kEuroc;
+  throw InputError(
+      path, 0,
+      "unrecognised dataset layout (expected a KITTI raw drive with oxts/ or image_00/, "
+      "or an EuRoC folder with mav0/)");
+}
+
+Dataset readDataset(const fs::path& path, std::optional<DatasetFormat> format,
+                    const ReaderConfig& config) {
+  config.validate();
+  const DatasetFormat f = format ? *format : detectFormat(path);
+  Dataset ds;
+  switch (f) {
+    case DatasetFormat::kKittiRaw:
+      ds = readKittiRaw(path, config);
+      break;
+    case DatasetFormat::kEuroc:
+      ds = readEuroc(path, config);
+      break;
+    case DatasetFormat::kNmea:
+      ds = readNmeaDataset(path, config);
+      break;
+  }
+  if (ds.frames.empty() && ds.imu.empty() && ds.gnss.empty()) {
+    throw InputError(path, 0, "dataset holds no camera frames, IMU samples or GNSS fixes");
+  }
+  return ds;
+}
+
+}  // namespace gvio::io

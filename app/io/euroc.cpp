@@ -1,0 +1,262 @@
+#include "io/euroc.hpp"
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "io/input_error.hpp"
+#include "io/text.hpp"
+#include "io/trajectory_io.hpp"
+
+namespace gvio::io {
+namespace fs = std::filesystem;
+namespace {
+
+// Kalibr writes "%YAML:1.0", which is not valid YAML 1.2: drop that directive before parsing.
+YAML::Node loadSensorYaml(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file, 0, "file not found");
+  std::stringstream text;
+  std::string line;
+  bool first = true;
+  while (std::getline(in, line)) {
+    if (first && line.rfind("%YAML", 0) == 0) line = "#" + line;
+    first = false;
+    text << line << '\n';
+  }
+  try {
+    YAML::Node root = YAML::Load(text.str());
+    if (!root.IsMap()) throw InputError(file, 0, "expected a YAML mapping of sensor parameters");
+    return root;
+  } catch (const YAML::Exception& e) {
+    throw InputError(file, static_cast<std::size_t>(e.mark.line + 1), e.msg);
+  }
+}
+
+template <typename T>
+std::vector<T> yamlList(const YAML::Node& root, const char* key, std::size_t count,
+                        const fs::path& file) {
+  const YAML::Node node = root[key];
+  if (!node || !node.IsSequence() || node.size() != count) {
+    throw InputError(file, node ? static_cast<std::size_t>(node.Mark().line + 1) : 0,
+                     fmt::format("'{}' must be a list of {} numbers", key, count));
+  }
+  try {
+    return node.as<std::vector<T>>();
+  } catch (const YAML::Exception&) {
+    throw InputError(file, static_cast<std::size_t>(node.Mark().line + 1),
+                     fmt::format("'{}' holds a non-numeric value", key));
+  }
+}
+
+Eigen::Isometry3d yamlTransform(const YAML::Node& root, const fs::path& file) {
+  if (!root["T_BS"]) return Eigen::Isometry3d::Identity();
+  const auto data = yamlList<double>(root["T_BS"], "data", 16, file);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.matrix() = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(data.data());
+  return T;
+}
+
+CameraModel readCameraYaml(const fs::path& file, const std::string& name) {
+  const YAML::Node y = loadSensorYaml(file);
+  const std::string model = y["camera_model"] ? y["camera_model"].Scalar() : "pinhole";
+  const std::string dist =
+      y["distortion_model"] ? y["distortion_model"].Scalar() : "radial-tangential";
+  if (model != "pinhole" || (dist != "radial-tangential" && dist != "radtan")) {
+    throw InputError(
+        file, 0,
+        fmt::format("unsupported camera model '{}' / '{}' (pinhole radial-tangential only)", model,
+                    dist));
+  }
+  CameraModel cam;
+  cam.name = name;
+  const auto res = yamlList<int>(y, "resolution", 2, file);
+  const auto k = yamlList<double>(y, "intrinsics", 4, file);
+  cam.width_px = res[0];
+  cam.height_px = res[1];
+  cam.fx = k[0];
+  cam.fy = k[1];
+  cam.cx = k[2];
+  cam.cy = k[3];
+  cam.distortion = yamlList<double>(y, "distortion_coefficients", 4, file);
+  cam.T_b_c = yamlTransform(y, file);
+  if (cam.width_px <= 0 || cam.height_px <= 0 || cam.fx <= 0.0 || cam.fy <= 0.0) {
+    throw InputError(file, 0, "resolution and focal lengths must be positive");
+  }
+  return cam;
+}
+
+// A CSV of "t_ns,..." rows with `fields` columns and strictly increasing stamps; calls `row` for
+// each data line.
+template <typename Fn>
+void readStampedCsv(const fs::path& file, std::size_t fields, Fn&& row) {
+  LineReader reader(file);
+  std::string line;
+  std::int64_t last = std::numeric_limits<std::int64_t>::min();
+  while (reader.next(line)) {
+    if (isBlankOrComment(line)) continue;
+    const auto f = splitDelimited(line, ',');
+    if (f.size() != fields)
+      reader.fail(fmt::format("expected {} fields, got {}", fields, f.size()));
+    const std::int64_t t_ns = parseInt64(f[0], reader, "timestamp [ns]");
+    if (t_ns <= last)
+      reader.fail(t_ns == last ? "duplicate timestamp" : "timestamp not increasing");
+    last = t_ns;
+    row(t_ns, f, reader);
+  }
+}
+
+void readImu(const fs::path& dir, Dataset& ds) {
+  const fs::path yaml = dir / "sensor.yaml";
+  if (fs::is_regular_file(yaml)) {
+    const YAML::Node y = loadSensorYaml(yaml);
+    ImuNoise n;
+    auto get = [&](const char* key) {
+      try {
+        return y[key] ? y[key].as<double>() : 0.0;
+      } catch (const YAML::Exception&) {
+        throw InputError(yaml, static_cast<std::size_t>(y[key].Mark().line + 1),
+                         fmt::format("'{}' must be a number", key));
+      }
+    };
+    n.gyr_noise_density = get("gyroscope_noise_density");
+    n.gyr_random_walk = get("gyroscope_random_walk");
+    n.acc_noise_density = get("accelerometer_noise_density");
+    n.acc_random_walk = get("accelerometer_random_walk");
+    ds.imu_noise = n;
+  }
+  readStampedCsv(dir / "data.csv", 7, [&](std::int64_t t_ns, const auto& f, const LineReader& at) {
+    ImuSample s;
+    s.t_ns = t_ns;
+    for (int i = 0; i < 3; ++i) {
+      s.gyr_b_radps[i] = parseFinite(f[1 + i], at, "angular rate");
+      s.acc_b_mps2[i] = parseFinite(f[4 + i], at, "acceleration");
+    }
+    ds.imu.push_back(s);
+  });
+}
+
+// Out-of-range positions and non-positive sigmas are skipped with a counted warning (never
+// used); NaN or malformed numbers are fatal like everywhere else.
+void readGnss(const fs::path& dir, Dataset& ds) {
+  const fs::path file = dir / "data.csv";
+  std::size_t skipped = 0, first_skipped_line = 0;
+  readStampedCsv(file, 6, [&](std::int64_t t_ns, const auto& f, const LineReader& at) {
+    GnssFix fix;
+    fix.t_ns = t_ns;
+    fix.lat_deg = parseFinite(f[1], at, "latitude");
+    fix.lon_deg = parseFinite(f[2], at, "longitude");
+    fix.h_ellipsoid_m = parseFinite(f[3], at, "height");
+    fix.sigma_h_m = parseFinite(f[4], at, "sigma_h");
+    fix.sigma_v_m = parseFinite(f[5], at, "sigma_v");
+    if (std::abs(fix.lat_deg) > 90.0 || std::abs(fix.lon_deg) > 180.0 || fix.sigma_h_m <= 0.0 ||
+        fix.sigma_v_m <= 0.0) {
+      if (skipped++ == 0) first_skipped_line = at.lineNumber();
+      return;
+    }
+    ds.gnss.push_back(fix);
+  });
+  if (skipped > 0) {
+    ds.warnings.push_back(fmt::format(
+        "{}: {} fixes with lat/lon out of range or non-positive sigma skipped (first at line {})",
+        file.string(), skipped, first_skipped_line));
+  }
+  ds.gnss_source = file.string();
+}
+
+// stamp -> image path for one camera; listed images whose file is missing are dropped with one
+// warning (the real EuRoC V1_01 cam1/data.csv lists stamps without images).
+std::map<std::int64_t, fs::path> readCameraList(const fs::path& dir, Dataset& ds) {
+  std::map<std::int64_t, fs::path> images;
+  std::size_t missing = 0, first_missing_line = 0;
+  readStampedCsv(dir / "data.csv", 2, [&](std::int64_t t_ns, const auto& f, const LineReader& at) {
+    const fs::path image = dir / "data" / std::string(f[1]);
+    if (!fs::is_regular_file(image)) {
+      if (missing++ == 0) first_missing_line = at.lineNumber();
+      return;
+    }
+    images.emplace(t_ns, image);
+  });
+  if (missing > 0) {
+    ds.warnings.push_back(
+        fmt::format("{}: {} listed images not found, frames skipped (first at line {})",
+                    (dir / "data.csv").string(), missing, first_missing_line));
+  }
+  return images;
+}
+
+void readCameras(const fs::path& mav0, const Eigen::Isometry3d& T_BS_imu, Dataset& ds) {
+  std::vector<std::map<std::int64_t, fs::path>> lists;
+  for (const char* name : {"cam0", "cam1"}) {
+    const fs::path dir = mav0 / name;
+    if (!fs::is_directory(dir)) break;  // cam1 without cam0 is not a camera setup we know
+    CameraModel cam = readCameraYaml(dir / "sensor.yaml", name);
+    cam.T_b_c = T_BS_imu.inverse() * cam.T_b_c;  // body = IMU frame
+    ds.cameras.push_back(cam);
+    lists.push_back(readCameraList(dir, ds));
+  }
+  if (lists.empty()) return;
+  std::size_t unpaired = 0;
+  for (const auto& [t_ns, path0] : lists[0]) {
+    FrameRecord frame{t_ns, {path0}};
+    for (std::size_t k = 1; k < lists.size(); ++k) {
+      const auto it = lists[k].find(t_ns);
+      if (it == lists[k].end()) break;
+      frame.image_paths.push_back(it->second);
+    }
+    if (frame.image_paths.size() == lists.size()) {
+      ds.frames.push_back(std::move(frame));
+    } else {
+      ++unpaired;
+    }
+  }
+  if (unpaired > 0) {
+    ds.warnings.push_back(
+        fmt::format("{}: {} cam0 frames have no cam1 image with the same stamp, skipped",
+                    mav0.string(), unpaired));
+  }
+}
+
+}  // namespace
+
+fs::path findEurocMav0(const fs::path& path) {
+  for (const auto& dir : {path / "mav0", path}) {
+    if (fs::is_directory(dir / "cam0") || fs::is_directory(dir / "imu0") ||
+        fs::is_directory(dir / "gnss0")) {
+      return dir;
+    }
+  }
+  return {};
+}
+
+Dataset readEuroc(const fs::path& path, const ReaderConfig& /*config*/) {
+  if (!fs::is_directory(path)) throw InputError(path, 0, "dataset folder not found");
+  const fs::path mav0 = findEurocMav0(path);
+  if (mav0.empty())
+    throw InputError(path, 0, "no mav0/ with cam0, imu0 or gnss0: not an EuRoC dataset");
+  Dataset ds;
+  ds.format = DatasetFormat::kEuroc;
+  ds.root = path;
+  ds.variant = "asl";
+  Eigen::Isometry3d T_BS_imu = Eigen::Isometry3d::Identity();
+  if (fs::is_directory(mav0 / "imu0")) {
+    if (fs::is_regular_file(mav0 / "imu0" / "sensor.yaml")) {
+      T_BS_imu = yamlTransform(loadSensorYaml(mav0 / "imu0" / "sensor.yaml"),
+                               mav0 / "imu0" / "sensor.yaml");
+    }
+    readImu(mav0 / "imu0", ds);
+  }
+  readCameras(mav0, T_BS_imu, ds);
+  if (fs::is_directory(mav0 / "gnss0")) readGnss(mav0 / "gnss0", ds);
+  const fs::path gt = mav0 / "state_groundtruth_estimate0" / "data.csv";
+  if (fs::is_regular_file(gt)) {
+    ds.groundtruth = readEurocCsv(gt);
+    ds.groundtruth_source = gt.string();
+  }
+  return ds;
+}
+
+}  // namespace gvio::io

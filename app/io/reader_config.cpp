@@ -1,0 +1,35 @@
+#include "io/reader_config.hpp"
+
+#include <cmath>
+
+#include "odometry/error.hpp"
+
+namespace gvio::io {
+namespace {
+
+void requirePositive(double value, const char* key) {
+  if (!std::isfinite(value) || value <= 0.0) {
+    throw InvalidInput(std::string("config: ") + key + " must be a positive number (got " +
+                       std::to_string(value) + ")");
+  }
+}
+
+}  // namespace
+
+void ReaderConfig::validate() const {
+  if (kitti_gnss_source != "auto" && kitti_gnss_source != "nmea" && kitti_gnss_source != "oxts") {
+    throw InvalidInput("config: dataset.kitti_gnss_source must be auto, nmea or oxts (got '" +
+                       kitti_gnss_source + "')");
+  }
+  if (!(gap_factor > 1.0) || !std::isfinite(gap_factor)) {
+    throw InvalidInput("config: dataset.gap_factor must be > 1 (got " + std::to_string(gap_factor) +
+                       ")");
+  }
+  requirePositive(nmea_uere_spp_m, "dataset.nmea_uere_spp_m");
+  requirePositive(nmea_uere_dgps_m, "dataset.nmea_uere_dgps_m");
+  requirePositive(nmea_uere_rtk_float_m, "dataset.nmea_uere_rtk_float_m");
+  requirePositive(nmea_uere_rtk_fixed_m, "dataset.nmea_uere_rtk_fixed_m");
+  requirePositive(nmea_vertical_factor, "dataset.nmea_vertical_factor");
+}
+
+}  // namespace gvio::io

@@ -1,0 +1,24 @@
+#pragma once
+// Options of the dataset readers (YAML section `dataset:`). Plain struct with defaults.
+#include <string>
+
+namespace gvio::io {
+
+struct ReaderConfig {
+  // KITTI raw: where GNSS comes from. auto = gnss/fixes.nmea when present, else oxts lat/lon/alt.
+  std::string kitti_gnss_source = "auto";  // auto | nmea | oxts
+  // A gap in a sensor stream is reported when a period exceeds gap_factor x the median period.
+  double gap_factor = 2.5;
+  // NMEA GGA carries no standard deviation: without a GST sentence the 1-sigma horizontal error is
+  // HDOP x this user-equivalent range error, chosen by fix quality.
+  double nmea_uere_spp_m = 1.5;
+  double nmea_uere_dgps_m = 0.7;
+  double nmea_uere_rtk_float_m = 0.3;
+  double nmea_uere_rtk_fixed_m = 0.02;
+  // Vertical sigma = horizontal sigma x this (VDOP is typically 1.5-2 x HDOP).
+  double nmea_vertical_factor = 2.0;
+
+  void validate() const;  // throws InvalidInput naming the key
+};
+
+}  // namespace gvio::io

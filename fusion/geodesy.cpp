@@ -1,0 +1,52 @@
+#include "fusion/geodesy.hpp"
+
+#include <GeographicLib/Geocentric.hpp>
+
+#include <cmath>
+
+namespace gvio::fusion {
+namespace {
+
+const GeographicLib::Geocentric& wgs84() {
+  return GeographicLib::Geocentric::WGS84();
+}
+
+}  // namespace
+
+Eigen::Vector3d llaToEcef(const Lla& lla) {
+  Eigen::Vector3d p;
+  wgs84().Forward(lla.lat_deg, lla.lon_deg, lla.h_ellipsoid_m, p.x(), p.y(), p.z());
+  return p;
+}
+
+Lla ecefToLla(const Eigen::Vector3d& p_ecef) {
+  Lla lla;
+  wgs84().Reverse(p_ecef.x(), p_ecef.y(), p_ecef.z(), lla.lat_deg, lla.lon_deg, lla.h_ellipsoid_m);
+  return lla;
+}
+
+EnuFrame::EnuFrame(const Lla& origin) : origin_(origin), origin_ecef_(llaToEcef(origin)) {
+  // Rows are the east, north and up unit vectors expressed in ECEF.
+  const double lat = origin.lat_deg * M_PI / 180.0;
+  const double lon = origin.lon_deg * M_PI / 180.0;
+  const double sl = std::sin(lat), cl = std::cos(lat), so = std::sin(lon), co = std::cos(lon);
+  R_enu_ecef_ << -so, co, 0.0,  //
+      -sl * co, -sl * so, cl,   //
+      cl * co, cl * so, sl;
+}
+
+Eigen::Vector3d EnuFrame::toEnu(const Lla& lla) const {
+  return R_enu_ecef_ * (llaToEcef(lla) - origin_ecef_);
+}
+
+Lla EnuFrame::toLla(const Eigen::Vector3d& p_enu) const {
+  return ecefToLla(origin_ecef_ + R_enu_ecef_.transpose() * p_enu);
+}
+
+bool isValidLla(const Lla& lla) {
+  return std::isfinite(lla.lat_deg) && std::isfinite(lla.lon_deg) &&
+         std::isfinite(lla.h_ellipsoid_m) && std::abs(lla.lat_deg) <= 90.0 &&
+         std::abs(lla.lon_deg) <= 180.0;
+}
+
+}  // namespace gvio::fusion

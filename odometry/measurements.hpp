@@ -1,0 +1,55 @@
+#pragma once
+// Plain measurement structs shared by every stage (OpenVINS style: data only, no behaviour).
+// Frames and units are in the names: *_mps2 = m/s^2, *_radps = rad/s, t_ns = int64 nanoseconds.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace gvio {
+
+// Specific force and angular rate in the body (IMU) frame.
+struct ImuSample {
+  std::int64_t t_ns = 0;
+  Eigen::Vector3d acc_b_mps2 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyr_b_radps = Eigen::Vector3d::Zero();
+};
+
+// One GNSS position fix at the antenna. Heights are ellipsoidal (WGS84); readers that get MSL
+// heights (NMEA GGA) add the geoid separation the receiver reports.
+struct GnssFix {
+  std::int64_t t_ns = 0;
+  double lat_deg = 0.0;
+  double lon_deg = 0.0;
+  double h_ellipsoid_m = 0.0;
+  double sigma_h_m = 0.0;  // 1-sigma horizontal (per axis)
+  double sigma_v_m = 0.0;  // 1-sigma vertical
+  int quality = 1;         // NMEA GGA fix quality (1 SPP, 2 DGPS, 4 RTK fixed, 5 RTK float)
+  double hdop = 0.0;       // 0 when the source does not report it
+  int num_sats = 0;        // 0 when the source does not report it
+};
+
+// Pinhole camera with radial-tangential (OpenCV plumb_bob) distortion and its pose in the body.
+struct CameraModel {
+  std::string name;
+  int width_px = 0;
+  int height_px = 0;
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+  std::vector<double> distortion;  // k1 k2 p1 p2 [k3], empty when rectified
+  Eigen::Isometry3d T_b_c = Eigen::Isometry3d::Identity();
+};
+
+// Noise densities of an IMU (continuous time), as Kalibr/EuRoC sensor.yaml state them.
+// Defaults: a typical automotive MEMS IMU (accelerometer ~200 ug/sqrt(Hz), gyro ~0.01
+// deg/s/sqrt(Hz)).
+struct ImuNoise {
+  double acc_noise_density = 2.0e-3;  // m/s^2/sqrt(Hz)
+  double gyr_noise_density = 1.7e-4;  // rad/s/sqrt(Hz)
+  double acc_random_walk = 3.0e-4;    // m/s^3/sqrt(Hz)
+  double gyr_random_walk = 2.0e-5;    // rad/s^2/sqrt(Hz)
+
+  void validate() const;  // throws InvalidInput: every density must be finite and > 0
+};
+
+}  // namespace gvio

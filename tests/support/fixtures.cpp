@@ -1,0 +1,210 @@
+#include "support/fixtures.hpp"
+
+#include <fmt/format.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "io/nmea.hpp"
+
+namespace gvio::test {
+namespace fs = std::filesystem;
+
+TempDir::TempDir(const std::string& tag) {
+  static std::atomic<int> counter{0};
+  path_ = fs::temp_directory_path() /
+          fmt::format("gvio_{}_{}_{}", tag, static_cast<long>(::getpid()), counter++);
+  fs::remove_all(path_);
+  fs::create_directories(path_);
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+}
+
+void writeText(const fs::path& file, const std::string& text) {
+  fs::create_directories(file.parent_path());
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+  if (!out) throw std::runtime_error("cannot write fixture " + file.string());
+}
+
+std::string readText(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void replaceLine(const fs::path& file, std::size_t line, const std::string& text) {
+  std::istringstream in(readText(file));
+  std::string out, current;
+  for (std::size_t n = 1; std::getline(in, current); ++n)
+    out += (n == line ? text : current) + "\n";
+  writeText(file, out);
+}
+
+namespace {
+
+// Real KITTI 2011_09_26 IMU->velodyne->camera extrinsics; intrinsics scaled to the tiny images.
+void writeCalib(const fs::path& dir, const KittiFixture& s) {
+  writeText(dir / "calib_imu_to_velo.txt",
+            "calib_time: 25-May-2012 16:47:16\n"
+            "R: 9.999976e-01 7.553071e-04 -2.035826e-03 -7.854027e-04 9.998898e-01 -1.482298e-02 "
+            "2.024406e-03 1.482454e-02 9.998881e-01\n"
+            "T: -8.086759e-01 3.195559e-01 -7.997231e-01\n");
+  writeText(dir / "calib_velo_to_cam.txt",
+            "calib_time: 15-Mar-2012 11:37:16\n"
+            "R: 7.533745e-03 -9.999714e-01 -6.166020e-04 1.480249e-02 7.280733e-04 -9.998902e-01 "
+            "9.998621e-01 7.523790e-03 1.480755e-02\n"
+            "T: -4.069766e-03 -7.631618e-02 -2.717806e-01\n"
+            "delta_f: 0.000000e+00 0.000000e+00\ndelta_c: 0.000000e+00 0.000000e+00\n");
+  const double f = 0.5 * s.width, cx = 0.5 * s.width, cy = 0.5 * s.height;
+  std::string c2c = "calib_time: 09-Jan-2012 13:57:47\ncorner_dist: 9.950000e-02\n";
+  for (int id = 0; id < 2; ++id) {
+    const double tx = id == 0 ? 0.0 : -0.537;
+    c2c += fmt::format("S_{:02d}: {} {}\n", id, s.width, s.height);
+    c2c += fmt::format("K_{:02d}: {} 0 {} 0 {} {} 0 0 1\n", id, f, cx, f, cy);
+    c2c += fmt::format("D_{:02d}: 0 0 0 0 0\n", id);
+    c2c += fmt::format("R_{:02d}: 1 0 0 0 1 0 0 0 1\n", id);
+    c2c += fmt::format("T_{:02d}: {} 0 0\n", id, tx);
+    c2c += fmt::format("S_rect_{:02d}: {} {}\n", id, s.width, s.height);
+    c2c += fmt::format("R_rect_{:02d}: 1 0 0 0 1 0 0 0 1\n", id);
+    c2c += fmt::format("P_rect_{:02d}: {} 0 {} {} 0 {} {} 0 0 0 1 0\n", id, f, cx, f * tx, f, cy);
+  }
+  writeText(dir / "calib_cam_to_cam.txt", c2c);
+}
+
+std::string kittiStamp(std::int64_t t_ns_of_day) {
+  const std::int64_t s = t_ns_of_day / 1'000'000'000LL;
+  return fmt::format("2011-09-26 {:02d}:{:02d}:{:02d}.{:09d}", s / 3600, (s / 60) % 60, s % 60,
+                     t_ns_of_day % 1'000'000'000LL);
+}
+
+constexpr std::int64_t kStartNs =
+    13LL * 3600 * 1'000'000'000LL + 2LL * 60 * 1'000'000'000LL;  // 13:02
+constexpr double kLat0 = 49.011, kLon0 = 8.4, kSpeed = 10.0;
+
+void latLonAt(double t_s, double& lat, double& lon) {
+  const double d = kSpeed * t_s / std::sqrt(2.0);  // metres north and east
+  lat = kLat0 + d / 111'200.0;
+  lon = kLon0 + d / (111'200.0 * std::cos(kLat0 * M_PI / 180.0));
+}
+
+void writeOxts(const fs::path& drive, const KittiFixture& s) {
+  const int n = static_cast<int>(std::lround((s.frames / 10.0) * s.oxts_rate_hz));
+  std::string stamps;
+  for (int i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / s.oxts_rate_hz;
+    stamps += kittiStamp(kStartNs + static_cast<std::int64_t>(std::llround(t * 1e9))) + "\n";
+    double lat = 0.0, lon = 0.0;
+    latLonAt(t, lat, lon);
+    // lat lon alt roll pitch yaw vn ve vf vl vu ax ay az af al au wx wy wz wf wl wu
+    // pos_accuracy vel_accuracy navstat numsats posmode velmode orimode
+    writeText(drive / "oxts" / "data" / fmt::format("{:010d}.txt", i),
+              fmt::format("{:.12f} {:.12f} 116.4 0.01 -0.02 0.785398 7.0711 7.0711 10 0 0 "
+                          "0.1 0.02 9.81 0.1 0.02 9.81 0.001 -0.002 0.003 0.001 -0.002 0.003 "
+                          "0.2 0.05 4 9 4 4 6\n",
+                          lat, lon));
+  }
+  writeText(drive / "oxts" / "timestamps.txt", stamps);
+}
+
+void writeImages(const fs::path& drive, const KittiFixture& s) {
+  for (int cam = 0; cam < 2; ++cam) {
+    std::string stamps;
+    for (int i = 0; i < s.frames; ++i) {
+      stamps += kittiStamp(kStartNs + i * 100'000'000LL + cam * 2'000) + "\n";
+      cv::Mat image(s.height, s.width, CV_8UC1);
+      for (int r = 0; r < s.height; ++r) {
+        for (int c = 0; c < s.width; ++c) {
+          image.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(
+              (c * 7 + r * 13 + i * 5 + cam * 3 + ((r / 4 + c / 4) % 2) * 60) % 256);
+        }
+      }
+      const fs::path file =
+          drive / fmt::format("image_{:02d}", cam) / "data" / fmt::format("{:010d}.png", i);
+      fs::create_directories(file.parent_path());
+      cv::imwrite(file.string(), image);
+    }
+    writeText(drive / fmt::format("image_{:02d}", cam) / "timestamps.txt", stamps);
+  }
+}
+
+std::string nmeaLatLon(double deg, bool is_lat) {
+  const double a = std::abs(deg);
+  const int d = static_cast<int>(a);
+  const char hemisphere = is_lat ? (deg >= 0 ? 'N' : 'S') : (deg >= 0 ? 'E' : 'W');
+  return fmt::format(fmt::runtime(is_lat ? "{:02d}{:010.7f},{}" : "{:03d}{:010.7f},{}"), d,
+                     (a - d) * 60.0, hemisphere);
+}
+
+void writeNmea(const fs::path& drive, const KittiFixture& s) {
+  std::string log;
+  for (int i = 0; i * 10 < s.frames; ++i) {
+    double lat = 0.0, lon = 0.0;
+    latLonAt(i, lat, lon);
+    const std::int64_t sec = kStartNs / 1'000'000'000LL + i;
+    const std::string hms =
+        fmt::format("{:02d}{:02d}{:02d}.00", sec / 3600, (sec / 60) % 60, sec % 60);
+    log += io::withNmeaChecksum(fmt::format("GPGGA,{},{},{},1,09,0.9,68.4,M,48.0,M,,", hms,
+                                            nmeaLatLon(lat, true), nmeaLatLon(lon, false))) +
+           "\r\n";
+    log += io::withNmeaChecksum(fmt::format("GPRMC,{},A,{},{},19.4,45.0,260911,,,A", hms,
+                                            nmeaLatLon(lat, true), nmeaLatLon(lon, false))) +
+           "\r\n";
+  }
+  writeText(drive / "gnss" / "fixes.nmea", log);
+}
+
+}  // namespace
+
+fs::path writeKittiFixture(const fs::path& base, const KittiFixture& s) {
+  const fs::path date_dir = base / "2011_09_26";
+  const fs::path drive = date_dir / s.drive_name;
+  fs::create_directories(drive);
+  writeCalib(s.calib_in_parent ? date_dir : drive, s);
+  writeOxts(drive, s);
+  writeImages(drive, s);
+  if (s.write_nmea) writeNmea(drive, s);
+  if (s.write_groundtruth) {
+    std::string tum = "# t x y z qx qy qz qw\n";
+    for (int i = 0; i < s.frames; ++i) {
+      const double t = 1e-9 * static_cast<double>(kStartNs + i * 100'000'000LL) + 1317042000.0;
+      tum += fmt::format("{:.9f} {:.3f} {:.3f} 0 0 0 0.3826834 0.9238795\n", t, 0.70711 * i,
+                         0.70711 * i);
+    }
+    writeText(drive / "groundtruth.tum", tum);
+  }
+  return drive;
+}
+
+fs::path sharedData(const std::string& relative) {
+  const fs::path p = fs::path(GVIO_SHARED_DATA_DIR) / relative;
+  return fs::exists(p) ? p : fs::path();
+}
+
+CommandResult runGvio(const std::string& args) {
+  static std::atomic<int> counter{0};
+  const fs::path tmp = fs::temp_directory_path() /
+                       fmt::format("gvio_cmd_{}_{}", static_cast<long>(::getpid()), counter++);
+  const std::string cmd = fmt::format("{} {} > {}.out 2> {}.err < /dev/null", GVIO_BINARY, args,
+                                      tmp.string(), tmp.string());
+  const int status = std::system(cmd.c_str());
+  CommandResult r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = readText(tmp.string() + ".out");
+  r.err = readText(tmp.string() + ".err");
+  fs::remove(tmp.string() + ".out");
+  fs::remove(tmp.string() + ".err");
+  return r;
+}
+
+}  // namespace gvio::test

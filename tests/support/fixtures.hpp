@@ -1,0 +1,52 @@
+#pragma once
+// Small datasets the tests write themselves (no real data needed), and helpers around them.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace gvio::test {
+
+// A fresh folder under the system temp dir, removed with its contents on destruction.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& tag);
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+void writeText(const std::filesystem::path& file, const std::string& text);
+std::string readText(const std::filesystem::path& file);
+// Replaces line `line` (1-based) of a text file.
+void replaceLine(const std::filesystem::path& file, std::size_t line, const std::string& text);
+
+struct KittiFixture {
+  std::string drive_name = "2011_09_26_drive_0001_extract";
+  int frames = 6;          // camera frames at 10 Hz
+  int oxts_rate_hz = 100;  // 100 = extract style, 10 = sync style
+  int width = 64, height = 24;
+  bool calib_in_parent = true;  // KITTI download layout: calib beside the drive folder
+  bool write_nmea = false;      // gnss/fixes.nmea at 1 Hz (the simulator's layout)
+  bool write_groundtruth = false;
+};
+
+// Writes a complete, valid KITTI raw drive under `base`/2011_09_26/ and returns the drive folder.
+// The drive moves north-east at 10 m/s from 49.011 N, 8.4 E; images are a textured gradient.
+std::filesystem::path writeKittiFixture(const std::filesystem::path& base,
+                                        const KittiFixture& spec);
+
+// Path of the real data folder (../shared/data beside the project), empty when absent.
+std::filesystem::path sharedData(const std::string& relative);
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+// Runs the built gvio binary with `args` (shell-quoted by the caller), capturing stdout/stderr.
+CommandResult runGvio(const std::string& args);
+
+}  // namespace gvio::test
