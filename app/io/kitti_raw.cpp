@@ -18,7 +18,7 @@ namespace {
 // Fields of one oxts/data/*.txt record (devkit dataformat.txt, 30 values).
 constexpr std::size_t kOxtsFields = 30;
 constexpr std::size_t kLat = 0, kLon = 1, kAlt = 2, kAf = 14, kWf = 20, kPosAccuracy = 23,
-                      kNumSats = 25;
+                      kNumSats = 26;  // 25 is navstat (devkit dataformat.txt)
 
 // timestamps.txt: one "YYYY-MM-DD hh:mm:ss.fffffffff" per line, strictly increasing.
 std::vector<std::int64_t> readKittiTimestamps(const fs::path& file) {

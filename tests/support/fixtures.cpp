@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "io/nmea.hpp"
+#include "io/text.hpp"
 
 namespace gvio::test {
 namespace fs = std::filesystem;
@@ -148,12 +149,16 @@ std::string nmeaLatLon(double deg, bool is_lat) {
 
 void writeNmea(const fs::path& drive, const KittiFixture& s) {
   std::string log;
-  for (int i = 0; i * 10 < s.frames; ++i) {
+  const int fixes = s.frames * s.nmea_rate_hz / 10;
+  for (int i = 0; i < fixes; ++i) {
+    const double t = static_cast<double>(i) / s.nmea_rate_hz;
     double lat = 0.0, lon = 0.0;
-    latLonAt(i, lat, lon);
-    const std::int64_t sec = kStartNs / 1'000'000'000LL + i;
-    const std::string hms =
-        fmt::format("{:02d}{:02d}{:02d}.00", sec / 3600, (sec / 60) % 60, sec % 60);
+    latLonAt(t, lat, lon);
+    const std::int64_t ms =
+        kStartNs / 1'000'000 + static_cast<std::int64_t>(std::llround(t * 1000));
+    const std::int64_t sec = ms / 1000;
+    const std::string hms = fmt::format("{:02d}{:02d}{:02d}.{:02d}", sec / 3600, (sec / 60) % 60,
+                                        sec % 60, (ms % 1000) / 10);
     log += io::withNmeaChecksum(fmt::format("GPGGA,{},{},{},1,09,0.9,68.4,M,48.0,M,,", hms,
                                             nmeaLatLon(lat, true), nmeaLatLon(lon, false))) +
            "\r\n";
@@ -174,16 +179,26 @@ fs::path writeKittiFixture(const fs::path& base, const KittiFixture& s) {
   writeOxts(drive, s);
   writeImages(drive, s);
   if (s.write_nmea) writeNmea(drive, s);
-  if (s.write_groundtruth) {
+  if (s.write_groundtruth) {  // body (IMU) poses in ENU: 1 m per frame north-east, yaw 45 deg
+    const std::int64_t midnight_ns = io::daysFromCivil(2011, 9, 26) * 86'400'000'000'000LL;
     std::string tum = "# t x y z qx qy qz qw\n";
     for (int i = 0; i < s.frames; ++i) {
-      const double t = 1e-9 * static_cast<double>(kStartNs + i * 100'000'000LL) + 1317042000.0;
-      tum += fmt::format("{:.9f} {:.3f} {:.3f} 0 0 0 0.3826834 0.9238795\n", t, 0.70711 * i,
-                         0.70711 * i);
+      tum += fmt::format("{} {:.6f} {:.6f} 0 0 0 0.3826834 0.9238795\n",
+                         io::formatSeconds(midnight_ns + kStartNs + i * 100'000'000LL),
+                         std::sqrt(0.5) * i, std::sqrt(0.5) * i);
     }
     writeText(drive / "groundtruth.tum", tum);
   }
   return drive;
+}
+
+KittiFixture demoFixture() {
+  KittiFixture spec;
+  spec.frames = 20;
+  spec.write_nmea = true;
+  spec.nmea_rate_hz = 5;
+  spec.write_groundtruth = true;
+  return spec;
 }
 
 fs::path sharedData(const std::string& relative) {

@@ -30,7 +30,8 @@ struct KittiFixture {
   int oxts_rate_hz = 100;  // 100 = extract style, 10 = sync style
   int width = 64, height = 24;
   bool calib_in_parent = true;  // KITTI download layout: calib beside the drive folder
-  bool write_nmea = false;      // gnss/fixes.nmea at 1 Hz (the simulator's layout)
+  bool write_nmea = false;      // gnss/fixes.nmea (the simulator's layout)
+  int nmea_rate_hz = 1;
   bool write_groundtruth = false;
 };
 
@@ -38,6 +39,9 @@ struct KittiFixture {
 // The drive moves north-east at 10 m/s from 49.011 N, 8.4 E; images are a textured gradient.
 std::filesystem::path writeKittiFixture(const std::filesystem::path& base,
                                         const KittiFixture& spec);
+
+// The embedded demo drive (assets/demo): 2 s, stereo 64x24, 100 Hz oxts, 5 Hz NMEA, truth.
+KittiFixture demoFixture();
 
 // Path of the real data folder (../shared/data beside the project), empty when absent.
 std::filesystem::path sharedData(const std::string& relative);

@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# gvio setup: installs exactly the Debian packages the project needs (apt-get update only when
+# something is missing), builds, and runs one of:
+#   ./setup.sh demo    the main job on the embedded demo drive (the default)
+#   ./setup.sh test    every test (ctest); this is what CI runs
+#   ./setup.sh build   install + build only
+# Idempotent and non-interactive. Environment: BUILD_DIR (default build), JOBS (default nproc).
+set -euo pipefail
+cd "$(dirname "$0")"
+mode="${1:-demo}"
+BUILD_DIR="${BUILD_DIR:-build}"
+JOBS="${JOBS:-$(nproc)}"
+
+PACKAGES=(
+  g++ cmake ninja-build pkg-config clang-format
+  libeigen3-dev libceres-dev libopencv-dev libpcl-dev liboctomap-dev
+  libegl-dev libgl-dev libepoxy-dev libegl-mesa0 libgl1-mesa-dri
+  libgeographiclib-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
+  nlohmann-json3-dev libcairo2-dev libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+install_packages() {
+  local missing=()
+  for p in "${PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "setup: installing ${missing[*]}"
+  local sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+}
+
+build() {
+  local werror=OFF
+  [ -n "${CI:-}" ] && werror=ON  # warnings are errors in CI
+  cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release -DGVIO_WERROR="$werror" >/dev/null
+  cmake --build "$BUILD_DIR" -j "$JOBS"
+}
+
+install_packages
+build
+case "$mode" in
+  build) ;;
+  test)
+    ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS"
+    ;;
+  demo)
+    drive=assets/demo/2011_09_26/2011_09_26_drive_0001_extract
+    mkdir -p out/demo
+    "$BUILD_DIR/app/gvio" inspect --dataset "$drive" --json out/demo/inspect.json
+    echo "setup: demo summary written to out/demo/inspect.json"
+    ;;
+  *)
+    echo "usage: ./setup.sh [demo|test|build]" >&2
+    exit 2
+    ;;
+esac

@@ -1,0 +1,122 @@
+#include "cli/config.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "io/input_error.hpp"
+#include "support/fixtures.hpp"
+
+namespace gvio::cli {
+namespace {
+using testing::HasSubstr;
+namespace fs = std::filesystem;
+
+const fs::path kConfigDir = fs::path(GVIO_SOURCE_DIR) / "assets" / "config";
+
+std::string errorOf(const ConfigSources& sources) {
+  try {
+    loadConfig(sources);
+  } catch (const InvalidInput& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Config, DefaultsValidate) {
+  EXPECT_NO_THROW(AppConfig{}.validate());
+}
+
+// default.yaml must document every key the schema knows, and nothing else.
+TEST(Config, DefaultYamlDocumentsEveryKey) {
+  std::vector<std::string> unknown;
+  const AppConfig loaded = loadConfig({kConfigDir / "default.yaml", {}}, &unknown);
+  EXPECT_TRUE(unknown.empty()) << unknown.front();
+  const std::string text = test::readText(kConfigDir / "default.yaml");
+  AppConfig config;
+  for (const auto& key : configKeys(config)) {
+    const std::string leaf = key.name.substr(key.name.find('.') + 1);
+    EXPECT_THAT(text, HasSubstr("\n  " + leaf + ":")) << key.name << " is not documented";
+  }
+  // The file states the defaults, so loading it changes nothing.
+  EXPECT_EQ(dumpConfigYaml(loaded), dumpConfigYaml(AppConfig{}));
+}
+
+TEST(Config, PresetsLoadWithoutUnknownKeys) {
+  for (const char* preset : {"kitti.yaml", "euroc.yaml"}) {
+    std::vector<std::string> unknown;
+    EXPECT_NO_THROW(loadConfig({kConfigDir / preset, {}}, &unknown)) << preset;
+    EXPECT_TRUE(unknown.empty()) << preset;
+  }
+  EXPECT_FALSE(loadConfig({kConfigDir / "kitti.yaml", {}}).imu.prefer_dataset_noise);
+}
+
+TEST(Config, FileThenOverrides) {
+  test::TempDir dir("config");
+  test::writeText(dir.path() / "c.yaml",
+                  "dataset:\n  gap_factor: 4\nimu:\n  acc_noise_density: 0.01\n");
+  const AppConfig c = loadConfig(
+      {dir.path() / "c.yaml", {"dataset.gap_factor=6", "imu.prefer_dataset_noise=false"}});
+  EXPECT_DOUBLE_EQ(c.dataset.gap_factor, 6.0);
+  EXPECT_DOUBLE_EQ(c.imu.noise.acc_noise_density, 0.01);
+  EXPECT_FALSE(c.imu.prefer_dataset_noise);
+}
+
+TEST(Config, UnknownFileKeyWarnsAndIsReported) {
+  test::TempDir dir("config");
+  test::writeText(dir.path() / "c.yaml", "dataset:\n  gap_factr: 4\n");
+  std::vector<std::string> unknown;
+  const AppConfig c = loadConfig({dir.path() / "c.yaml", {}}, &unknown);
+  ASSERT_EQ(unknown.size(), 1u);
+  EXPECT_EQ(unknown[0], "dataset.gap_factr");
+  EXPECT_DOUBLE_EQ(c.dataset.gap_factor, 2.5);
+}
+
+TEST(Config, BadValueNamesFileLineAndKey) {
+  test::TempDir dir("config");
+  const fs::path file = dir.path() / "c.yaml";
+  test::writeText(file, "dataset:\n  gap_factor: fast\n");
+  const std::string err = errorOf({file, {}});
+  EXPECT_THAT(err, HasSubstr(file.string() + ":2:"));
+  EXPECT_THAT(err, HasSubstr("dataset.gap_factor"));
+}
+
+TEST(Config, ValidateRejectsOutOfRange) {
+  EXPECT_THAT(errorOf({std::nullopt, {"dataset.gap_factor=0.5"}}), HasSubstr("dataset.gap_factor"));
+  EXPECT_THAT(errorOf({std::nullopt, {"imu.gyr_noise_density=-1"}}),
+              HasSubstr("imu.gyr_noise_density"));
+  EXPECT_THAT(errorOf({std::nullopt, {"dataset.kitti_gnss_source=gps"}}),
+              HasSubstr("kitti_gnss_source"));
+  EXPECT_THAT(errorOf({std::nullopt, {"imu.prefer_dataset_noise=maybe"}}),
+              HasSubstr("true or false"));
+  EXPECT_THAT(errorOf({std::nullopt, {"dataset.gap_factor=nan"}}), HasSubstr("finite"));
+}
+
+TEST(Config, OverrideErrors) {
+  EXPECT_THAT(errorOf({std::nullopt, {"dataset.nope=1"}}),
+              HasSubstr("unknown config key 'dataset.nope'"));
+  EXPECT_THAT(errorOf({std::nullopt, {"gap_factor"}}), HasSubstr("expected key=value"));
+}
+
+TEST(Config, FileErrors) {
+  test::TempDir dir("config");
+  EXPECT_THAT(errorOf({dir.path() / "missing.yaml", {}}), HasSubstr("not found"));
+  test::writeText(dir.path() / "bad.yaml", "dataset: [1, 2\n");
+  EXPECT_THAT(errorOf({dir.path() / "bad.yaml", {}}), HasSubstr("YAML syntax"));
+  test::writeText(dir.path() / "list.yaml", "- 1\n- 2\n");
+  EXPECT_THAT(errorOf({dir.path() / "list.yaml", {}}), HasSubstr("mapping"));
+  test::writeText(dir.path() / "empty.yaml", "");
+  EXPECT_TRUE(errorOf({dir.path() / "empty.yaml", {}}).empty());
+}
+
+TEST(Config, DumpRoundTrips) {
+  const AppConfig changed =
+      loadConfig({std::nullopt, {"dataset.gap_factor=3.25", "imu.acc_random_walk=1e-5"}});
+  test::TempDir dir("config");
+  test::writeText(dir.path() / "dump.yaml", dumpConfigYaml(changed));
+  EXPECT_EQ(dumpConfigYaml(loadConfig({dir.path() / "dump.yaml", {}})), dumpConfigYaml(changed));
+}
+
+}  // namespace
+}  // namespace gvio::cli
