@@ -16,7 +16,7 @@ PACKAGES=(
   libeigen3-dev libceres-dev libopencv-dev libpcl-dev liboctomap-dev
   libegl-dev libgl-dev libepoxy-dev libegl-mesa0 libgl1-mesa-dri
   libgeographiclib-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
-  nlohmann-json3-dev libcairo2-dev libgtest-dev libgmock-dev libbenchmark-dev
+  nlohmann-json3-dev libcairo2-dev zlib1g-dev libgtest-dev libgmock-dev libbenchmark-dev
 )
 
 install_packages() {
