@@ -74,6 +74,7 @@ int runMain(int argc, char** argv) {
   // Each subcommand is registered here only once it really works.
   std::vector<Command> commands;
   commands.push_back(addInspectCommand(app, common));
+  commands.push_back(addEvalCommand(app));
 
   try {
     app.parse(argc, argv);

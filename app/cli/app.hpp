@@ -36,6 +36,7 @@ struct Command {
 };
 
 Command addInspectCommand(CLI::App& app, const CommonOptions& common);
+Command addEvalCommand(CLI::App& app);
 
 int runMain(int argc, char** argv);
 

@@ -278,4 +278,19 @@ void writeTrajectory(const fs::path& file, const Trajectory& traj, TrajectoryFor
   }
 }
 
+TrajectoryFormat detectTrajectoryFormat(const fs::path& file) {
+  LineReader reader(file);
+  std::string line;
+  while (reader.next(line)) {
+    if (isBlankOrComment(line)) continue;
+    if (line.find(',') != std::string::npos) return TrajectoryFormat::kEuroc;
+    const std::size_t fields = splitWhitespace(line).size();
+    if (fields == 8) return TrajectoryFormat::kTum;
+    if (fields == 12) return TrajectoryFormat::kKitti;
+    reader.fail("cannot tell the trajectory format from " + std::to_string(fields) +
+                " fields (TUM has 8, KITTI 12, EuRoC is comma separated)");
+  }
+  throw InputError(file, 0, "no poses");
+}
+
 }  // namespace gvio::io

@@ -21,6 +21,10 @@ enum class TrajectoryFormat { kTum, kKitti, kEuroc };
 std::optional<TrajectoryFormat> parseTrajectoryFormat(std::string_view name);
 std::string toString(TrajectoryFormat format);
 
+// Guesses the format from the first data line: commas -> EuRoC, 8 fields -> TUM, 12 -> KITTI.
+// Throws InputError naming file and line when none fits.
+TrajectoryFormat detectTrajectoryFormat(const std::filesystem::path& file);
+
 Trajectory readTum(const std::filesystem::path& file);
 // Without `times_file` the result has no timestamps. With it, the times file holds one seconds
 // value per pose (the KITTI odometry times.txt layout) and the counts must match.
