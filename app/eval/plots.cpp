@@ -12,6 +12,7 @@
 
 #include "io/atomic_write.hpp"
 #include "odometry/error.hpp"
+#include "render/colormap.hpp"
 
 namespace gvio::eval {
 namespace {
@@ -28,23 +29,10 @@ constexpr Rgb kInk{0.15, 0.15, 0.15}, kGrid{0.9, 0.9, 0.9}, kRefGrey{0.5, 0.5, 0
 constexpr Rgb kBlue{0.12, 0.47, 0.71}, kOrange{1.0, 0.5, 0.05}, kGreen{0.17, 0.63, 0.17};
 constexpr Rgb kRed{0.84, 0.15, 0.16}, kOutage{0.55, 0.55, 0.55};
 
-// matplotlib's viridis sampled at i/15 (entries 17 i of its 256-entry table).
-// clang-format off
-constexpr std::array<Rgb, 16> kViridis = {{
-    {0.267004, 0.004874, 0.329415}, {0.282656, 0.100196, 0.422160}, {0.277134, 0.185228, 0.489898}, {0.253935, 0.265254, 0.529983},
-    {0.221989, 0.339161, 0.548752}, {0.190631, 0.407061, 0.556089}, {0.163625, 0.471133, 0.558148}, {0.139147, 0.533812, 0.555298},
-    {0.120565, 0.596422, 0.543611}, {0.134692, 0.658636, 0.517649}, {0.208030, 0.718701, 0.472873}, {0.327796, 0.773980, 0.406640},
-    {0.477504, 0.821444, 0.318195}, {0.647257, 0.858400, 0.209861}, {0.824940, 0.884720, 0.106217}, {0.993248, 0.906157, 0.143936},
-}};
-// clang-format on
-
+// The project's viridis (render/colormap), in this file's double-precision colour type.
 Rgb viridis(double u) {
-  const double x = std::clamp(std::isfinite(u) ? u : 0.0, 0.0, 1.0) * (kViridis.size() - 1);
-  const std::size_t i = std::min(static_cast<std::size_t>(x), kViridis.size() - 2);
-  const double f = x - static_cast<double>(i);
-  const Rgb& a = kViridis[i];
-  const Rgb& b = kViridis[i + 1];
-  return {a.r + f * (b.r - a.r), a.g + f * (b.g - a.g), a.b + f * (b.b - a.b)};
+  const render::Rgb c = render::colormap(render::ColorMap::kViridis, std::isfinite(u) ? u : 0.0);
+  return {static_cast<double>(c.r), static_cast<double>(c.g), static_cast<double>(c.b)};
 }
 
 void setColour(cairo_t* cr, Rgb c, double alpha = 1.0) {
@@ -349,9 +337,10 @@ void drawStartEnd(cairo_t* cr, const Frame& f, const PlotData& d) {
 void drawColourBar(cairo_t* cr, double x, double y, double h, Range err, const std::string& label) {
   constexpr double kBarW = 22.0;
   cairo_pattern_t* gradient = cairo_pattern_create_linear(0.0, y + h, 0.0, y);
-  for (std::size_t i = 0; i < kViridis.size(); ++i) {
-    const Rgb& c = kViridis[i];
-    cairo_pattern_add_color_stop_rgb(gradient, i / (kViridis.size() - 1.0), c.r, c.g, c.b);
+  constexpr int kStops = 32;
+  for (int i = 0; i <= kStops; ++i) {
+    const Rgb c = viridis(static_cast<double>(i) / kStops);
+    cairo_pattern_add_color_stop_rgb(gradient, static_cast<double>(i) / kStops, c.r, c.g, c.b);
   }
   cairo_rectangle(cr, x, y, kBarW, h);
   cairo_set_source(cr, gradient);
