@@ -8,6 +8,8 @@
 namespace gvio::render {
 namespace {
 
+const Color kWhite(1, 1, 1, 1), kLightGrey(0.7F, 0.7F, 0.7F, 1);
+
 // Interleaved vertex of lines and points: position (relative to the scene origin), colour, size.
 struct StyledVertex {
   float pos[3];
@@ -15,8 +17,11 @@ struct StyledVertex {
   float size;
 };
 
+// The i-th of n items' value: `fallback` when none is given, the single value, or its own.
 template <typename T>
-const T& pick(const std::vector<T>& values, std::size_t i, std::size_t n, const char* what) {
+T pick(const std::vector<T>& values, std::size_t i, std::size_t n, const T& fallback,
+       const char* what) {
+  if (values.empty()) return fallback;
   if (values.size() != 1 && values.size() != n) {
     throw RenderError(
         fmt::format("{}: {} values for {} items (expected 1 or one each)", what, values.size(), n));
@@ -77,12 +82,13 @@ std::vector<float> unitCube() {
 
 }  // namespace
 
-GpuScene::GpuScene(const Scene& scene) : bounds_(scene.bounds()), background_(scene.background) {
+GpuScene::GpuScene(const Scene& scene, const UploadOptions& options)
+    : bounds_(scene.bounds()), background_(scene.background) {
   if (!bounds_.isEmpty()) origin_ = bounds_.center();
   uploadLines(scene);
   uploadPoints(scene);
   uploadVoxels(scene);
-  uploadMeshes(scene);
+  uploadMeshes(scene, options.max_anisotropy);
   glBindVertexArray(0);
   checkGl("GpuScene upload");
 }
@@ -99,8 +105,8 @@ void GpuScene::uploadLines(const Scene& scene) {
     strips_.push_back({static_cast<GLint>(v.size()), static_cast<GLsizei>(l.points.size()), true});
     for (std::size_t i = 0; i < l.points.size(); ++i) {
       v.push_back(styled(l.points[i], origin_,
-                         pick(l.colors, i, l.points.size(), "polyline colours"),
-                         pick(l.widths_px, i, l.points.size(), "polyline widths")));
+                         pick(l.colors, i, l.points.size(), kWhite, "polyline colours"),
+                         pick(l.widths_px, i, l.points.size(), 2.0F, "polyline widths")));
     }
   }
   const auto first_segment = static_cast<GLint>(v.size());
@@ -146,8 +152,9 @@ void GpuScene::uploadPoints(const Scene& scene) {
     point_ranges_.push_back(
         {static_cast<GLint>(v.size()), static_cast<GLsizei>(c.points.size()), c.round});
     for (std::size_t i = 0; i < c.points.size(); ++i) {
-      v.push_back(styled(c.points[i], origin_, pick(c.colors, i, c.points.size(), "point colours"),
-                         pick(c.sizes_px, i, c.points.size(), "point sizes")));
+      v.push_back(styled(c.points[i], origin_,
+                         pick(c.colors, i, c.points.size(), kWhite, "point colours"),
+                         pick(c.sizes_px, i, c.points.size(), 2.0F, "point sizes")));
     }
   }
   if (v.empty()) return;
@@ -175,7 +182,7 @@ void GpuScene::uploadVoxels(const Scene& scene) {
     inst.reserve(set.centers.size() * 7);
     for (std::size_t i = 0; i < set.centers.size(); ++i) {
       const Eigen::Vector3f c = (set.centers[i] - origin_).cast<float>();
-      const Color& col = pick(set.colors, i, set.centers.size(), "voxel colours");
+      const Color col = pick(set.colors, i, set.centers.size(), kLightGrey, "voxel colours");
       inst.insert(inst.end(), {c.x(), c.y(), c.z(), col[0], col[1], col[2], col[3]});
     }
     Voxels vox;
@@ -204,7 +211,7 @@ void GpuScene::uploadVoxels(const Scene& scene) {
   }
 }
 
-void GpuScene::uploadMeshes(const Scene& scene) {
+void GpuScene::uploadMeshes(const Scene& scene, float max_anisotropy) {
   for (const auto& t : scene.textures) {
     if (t.width < 1 || t.height < 1 || (t.channels != 1 && t.channels != 3 && t.channels != 4) ||
         t.data.size() != static_cast<std::size_t>(t.width) * static_cast<std::size_t>(t.height) *
@@ -219,15 +226,15 @@ void GpuScene::uploadMeshes(const Scene& scene) {
     const GLint internal = t.channels == 1 ? GL_R8 : (t.channels == 3 ? GL_RGB8 : GL_RGBA8);
     glTexImage2D(GL_TEXTURE_2D, 0, internal, t.width, t.height, 0, format, GL_UNSIGNED_BYTE,
                  t.data.data());
-    // Mipmaps with trilinear (and anisotropic, where offered) filtering: distant texture must not
-    // alias into false corners for the feature tracker.
+    // Mipmaps with trilinear (optionally anisotropic) filtering: distant texture must not alias
+    // into false corners for the feature tracker.
     glGenerateMipmap(GL_TEXTURE_2D);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-    if (epoxy_has_gl_extension("GL_EXT_texture_filter_anisotropic")) {
-      glTexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_ANISOTROPY_EXT, 8.0F);
+    if (max_anisotropy > 1.0F && epoxy_has_gl_extension("GL_EXT_texture_filter_anisotropic")) {
+      glTexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_ANISOTROPY_EXT, max_anisotropy);
     }
     textures_.push_back(std::move(tex));
     texture_grey_.push_back(t.channels == 1);

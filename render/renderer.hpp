@@ -12,10 +12,16 @@
 
 namespace gvio::render {
 
+struct UploadOptions {
+  // Anisotropic texture filtering keeps grazing-angle texture (the road) sharp, but on llvmpipe
+  // 8x costs ~6x the frame time of a KITTI-sized view (README, render benchmark); 1 = off.
+  float max_anisotropy = 1.0F;
+};
+
 class GpuScene {
  public:
   // Needs a current context. Throws RenderError for inconsistent per-item vectors or textures.
-  explicit GpuScene(const Scene& scene);
+  explicit GpuScene(const Scene& scene, const UploadOptions& options = {});
 
   [[nodiscard]] const Eigen::AlignedBox3d& bounds() const { return bounds_; }
   [[nodiscard]] bool empty() const;
@@ -42,7 +48,7 @@ class GpuScene {
   void uploadLines(const Scene& scene);
   void uploadPoints(const Scene& scene);
   void uploadVoxels(const Scene& scene);
-  void uploadMeshes(const Scene& scene);
+  void uploadMeshes(const Scene& scene, float max_anisotropy);
 
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();  // vertices are stored relative to it (float)
   Eigen::AlignedBox3d bounds_;

@@ -1,6 +1,7 @@
 #pragma once
 // What the renderer can draw, as plain data in a world frame (ENU metres for maps). Colours are
-// linear RGBA in [0, 1]. Per-item colour/size vectors hold either one value for all or one each.
+// linear RGBA in [0, 1]. Per-item colour/size vectors hold nothing (the default), one value for
+// all items, or one value each.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -14,20 +15,20 @@ using Color = Eigen::Vector4f;
 
 struct Polyline {  // trajectories
   std::vector<Eigen::Vector3d> points;
-  std::vector<Color> colors{Color(1, 1, 1, 1)};
-  std::vector<float> widths_px{2.0F};
+  std::vector<Color> colors;     // default white
+  std::vector<float> widths_px;  // default 2 px
 };
 
 struct PointCloud {
   std::vector<Eigen::Vector3d> points;
-  std::vector<Color> colors{Color(1, 1, 1, 1)};
-  std::vector<float> sizes_px{2.0F};
-  bool round = true;  // discs instead of squares
+  std::vector<Color> colors;    // default white
+  std::vector<float> sizes_px;  // default 2 px
+  bool round = true;            // discs instead of squares
 };
 
 struct VoxelSet {  // axis-aligned cubes (OctoMap leaves), drawn instanced
   std::vector<Eigen::Vector3d> centers;
-  std::vector<Color> colors{Color(0.7F, 0.7F, 0.7F, 1)};
+  std::vector<Color> colors;  // default light grey
   double size_m = 0.2;
 };
 

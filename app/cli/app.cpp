@@ -75,6 +75,7 @@ int runMain(int argc, char** argv) {
   std::vector<Command> commands;
   commands.push_back(addInspectCommand(app, common));
   commands.push_back(addEvalCommand(app));
+  commands.push_back(addRenderCommand(app));
 
   try {
     app.parse(argc, argv);

@@ -37,6 +37,7 @@ struct Command {
 
 Command addInspectCommand(CLI::App& app, const CommonOptions& common);
 Command addEvalCommand(CLI::App& app);
+Command addRenderCommand(CLI::App& app);
 
 int runMain(int argc, char** argv);
 

@@ -207,11 +207,15 @@ fs::path sharedData(const std::string& relative) {
 }
 
 CommandResult runGvio(const std::string& args) {
+  return runGvioWithEnv("", args);
+}
+
+CommandResult runGvioWithEnv(const std::string& env, const std::string& args) {
   static std::atomic<int> counter{0};
   const fs::path tmp = fs::temp_directory_path() /
                        fmt::format("gvio_cmd_{}_{}", static_cast<long>(::getpid()), counter++);
-  const std::string cmd = fmt::format("{} {} > {}.out 2> {}.err < /dev/null", GVIO_BINARY, args,
-                                      tmp.string(), tmp.string());
+  const std::string cmd = fmt::format("{} {} {} > {}.out 2> {}.err < /dev/null", env, GVIO_BINARY,
+                                      args, tmp.string(), tmp.string());
   const int status = std::system(cmd.c_str());
   CommandResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -52,5 +52,7 @@ struct CommandResult {
 };
 // Runs the built gvio binary with `args` (shell-quoted by the caller), capturing stdout/stderr.
 CommandResult runGvio(const std::string& args);
+// The same with environment assignments ("NAME=value ...") in front of the command.
+CommandResult runGvioWithEnv(const std::string& env, const std::string& args);
 
 }  // namespace gvio::test

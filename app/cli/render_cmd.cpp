@@ -1,0 +1,91 @@
+// gvio render: draws what a run folder holds into a PNG, off-screen through EGL.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <regex>
+
+#include "cli/app.hpp"
+#include "io/atomic_write.hpp"
+#include "io/input_error.hpp"
+#include "odometry/error.hpp"
+#include "render/framebuffer.hpp"
+#include "render/renderer.hpp"
+#include "viz/run_views.hpp"
+
+namespace gvio::cli {
+namespace {
+
+struct RenderCliOptions {
+  std::string run, out, view = "topdown", size = "1600x1200";
+  std::optional<std::string> reference;
+};
+
+std::pair<int, int> parseSize(const std::string& text) {
+  static const std::regex kSize(R"((\d{1,6})x(\d{1,6}))");
+  std::smatch m;
+  if (!std::regex_match(text, m, kSize))
+    throw gvio::InvalidInput("--size '" + text + "': expected WxH, e.g. 1600x1200");
+  const int w = std::stoi(m[1]), h = std::stoi(m[2]);
+  if (w < 1 || h < 1 || w > render::kMaxImageSize || h > render::kMaxImageSize) {
+    throw gvio::InvalidInput(
+        fmt::format("--size {}x{}: each side must be 1..{} px", w, h, render::kMaxImageSize));
+  }
+  return {w, h};
+}
+
+void writePng(const std::string& file, const render::ImageRgba& image) {
+  cv::Mat rgba(image.height, image.width, CV_8UC4, const_cast<std::uint8_t*>(image.rgba.data())),
+      bgr;
+  cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
+  std::vector<std::uint8_t> png;
+  cv::imencode(".png", bgr, png);
+  io::writeFileAtomic(file, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  });
+}
+
+int runRender(const RenderCliOptions& o) {
+  const viz::RunView view = viz::parseRunView(o.view);
+  const auto [width, height] = parseSize(o.size);
+  std::optional<std::filesystem::path> reference;
+  if (o.reference) reference = *o.reference;
+  const std::filesystem::path out_dir = std::filesystem::absolute(o.out).parent_path();
+  if (!std::filesystem::is_directory(out_dir)) {
+    throw io::InputError(o.out, 0, "output folder does not exist");  // before rendering for nothing
+  }
+  const io::RunFiles run = io::readRunDir(o.run, reference);
+  viz::ViewSpec spec = viz::buildRunView(run, view, width, height);
+  const render::EglContext context;
+  spdlog::info("EGL {}: {} ({})", context.info().platform, context.info().gl_renderer,
+               context.info().gl_version);
+  const render::Renderer renderer(context);
+  render::Framebuffer target(width, height);
+  const render::GpuScene gpu(spec.scene);
+  render::ImageRgba image = renderer.renderColor(gpu, spec.camera, target);
+  render::annotate(image, spec.annotations);
+  writePng(o.out, image);
+  spdlog::info("wrote {} ({}x{}, view {})", o.out, width, height, o.view);
+  return 0;
+}
+
+}  // namespace
+
+Command addRenderCommand(CLI::App& app) {
+  auto o = std::make_shared<RenderCliOptions>();
+  CLI::App* sub =
+      app.add_subcommand("render", "Draw a run's trajectories off-screen (EGL) into a PNG");
+  sub->add_option("--run", o->run,
+                  "Run folder (trajectory.tum / trajectory_vio.tum, optional groundtruth.tum)")
+      ->required();
+  sub->add_option("--view", o->view,
+                  "topdown, perspective, or error (colour = APE against the truth)");
+  sub->add_option("--size", o->size, "Image size WxH (1..16384 px per side)");
+  sub->add_option("--reference", o->reference,
+                  "Ground truth file (TUM/KITTI/EuRoC) instead of groundtruth.tum");
+  sub->add_option("--out", o->out, "Output PNG")->required();
+  return {sub, [o] { return runRender(*o); }};
+}
+
+}  // namespace gvio::cli
