@@ -197,27 +197,5 @@ TEST_F(PlotsTest, InconsistentOrEmptyInputThrows) {
   EXPECT_FALSE(fs::exists(prefix("bad_trajectory.png")));
 }
 
-// Not a check: renders the synthetic loop where a person can look at it.
-TEST(PlotsDemo, DISABLED_WritesDemoImages) {
-  writePlots(syntheticLoop(), "/tmp/plots_demo");
-  PlotData tall = syntheticLoop();  // a 1.2 km north-south drive, large errors, two outages
-  for (std::size_t i = 0; i < tall.p_ref.size(); ++i) {
-    const double s = static_cast<double>(i) / 199.0;
-    tall.p_ref[i] = Eigen::Vector3d(-300.0 + 40.0 * std::sin(9.0 * s), -600.0 + 1200.0 * s, 2.0);
-    tall.p_est[i] = tall.p_ref[i] + Eigen::Vector3d(20.0 * s * s, -5.0 * s, 1.0 - s);
-    tall.error[i] = (tall.p_est[i] - tall.p_ref[i]).norm();
-  }
-  fillStats(tall);
-  tall.outages_s = {{-10.0, 5.0}, {60.0, 200.0}};
-  writePlots(tall, "/tmp/plots_demo_tall");
-  PlotData single;
-  single.title = "single pose";
-  single.error_label = "APE (m)";
-  single.t_s = {0.0};
-  single.p_ref = single.p_est = {Eigen::Vector3d(1000.0, 2000.0, 3.0)};
-  single.error = {0.0};
-  writePlots(single, "/tmp/plots_demo_single");
-}
-
 }  // namespace
 }  // namespace gvio::eval
