@@ -15,25 +15,17 @@
 #include "io/measurement_stream.hpp"
 #include "io/nmea.hpp"
 #include "odometry/error.hpp"
+#include "support/errors.hpp"
 #include "support/fixtures.hpp"
 
 namespace gvio::io {
 namespace {
 
 namespace fs = std::filesystem;
+using test::inputError;
+using test::names;
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
-
-template <typename Fn>
-std::string inputError(Fn&& fn) {
-  try {
-    fn();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected an InputError";
-  return {};
-}
 
 class DatasetTest : public ::testing::Test {
  protected:

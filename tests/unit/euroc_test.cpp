@@ -17,40 +17,18 @@
 #include "io/dataset.hpp"
 #include "io/image_loader.hpp"
 #include "io/input_error.hpp"
+#include "support/errors.hpp"
 #include "support/fixtures.hpp"
 
 namespace gvio::io {
 namespace {
 
 namespace fs = std::filesystem;
+using test::inputError;
+using test::names;
 using ::testing::HasSubstr;
 
 constexpr std::int64_t kT0 = 1'403'715'273'262'142'976;  // the V1_01 clip's first IMU stamp
-
-template <typename Fn>
-std::string inputError(Fn&& fn) {
-  try {
-    fn();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected an InputError";
-  return {};
-}
-
-// True when `message` is "<file>[:<line>]: ..." (line 0: no line) and mentions `phrase`.
-::testing::AssertionResult names(const std::string& message, const fs::path& file, std::size_t line,
-                                 const std::string& phrase) {
-  const std::string where = file.string() + (line > 0 ? ":" + std::to_string(line) : "") + ": ";
-  if (!message.starts_with(where)) {
-    return ::testing::AssertionFailure()
-           << "'" << message << "' does not start with '" << where << "'";
-  }
-  if (message.find(phrase) == std::string::npos) {
-    return ::testing::AssertionFailure() << "'" << message << "' lacks '" << phrase << "'";
-  }
-  return ::testing::AssertionSuccess();
-}
 
 // ---- the real clip ----
 

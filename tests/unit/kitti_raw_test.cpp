@@ -14,42 +14,21 @@
 
 #include "io/dataset.hpp"
 #include "io/input_error.hpp"
+#include "support/errors.hpp"
 #include "support/fixtures.hpp"
 
 namespace gvio::io {
 namespace {
 
 namespace fs = std::filesystem;
+using test::inputError;
+using test::names;
 using ::testing::HasSubstr;
 
 // 2011-09-26 13:02:00 UTC, the fixture's first oxts and image_00 stamp.
 constexpr std::int64_t kStartNs = (1316995200LL + 13 * 3600 + 2 * 60) * 1'000'000'000LL;
 
 // The what() of the InputError `fn` throws, or "" (with a test failure) when it throws none.
-template <typename Fn>
-std::string inputError(Fn&& fn) {
-  try {
-    fn();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected an InputError";
-  return {};
-}
-
-// True when `message` is "<file>[:<line>]: ..." (line 0: no line) and mentions `phrase`.
-::testing::AssertionResult names(const std::string& message, const fs::path& file, std::size_t line,
-                                 const std::string& phrase) {
-  const std::string where = file.string() + (line > 0 ? ":" + std::to_string(line) : "") + ": ";
-  if (!message.starts_with(where)) {
-    return ::testing::AssertionFailure()
-           << "'" << message << "' does not start with '" << where << "'";
-  }
-  if (message.find(phrase) == std::string::npos) {
-    return ::testing::AssertionFailure() << "'" << message << "' lacks '" << phrase << "'";
-  }
-  return ::testing::AssertionSuccess();
-}
 
 // Removes every line of `file` that starts with `prefix`.
 void dropLines(const fs::path& file, const std::string& prefix) {

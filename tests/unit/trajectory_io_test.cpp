@@ -11,11 +11,14 @@
 
 #include "io/input_error.hpp"
 #include "odometry/error.hpp"
+#include "support/errors.hpp"
 
 namespace gvio::io {
 namespace {
 
 namespace fs = std::filesystem;
+using test::inputError;
+using test::names;
 
 class TrajectoryIoTest : public ::testing::Test {
  protected:
@@ -37,30 +40,6 @@ class TrajectoryIoTest : public ::testing::Test {
 
   fs::path dir_;
 };
-
-// The what() of the InputError `fn` throws, or "" (with a test failure) when it throws none.
-std::string inputError(const std::function<void()>& fn) {
-  try {
-    fn();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected an InputError";
-  return {};
-}
-
-// True when `message` is "<file>:<line>: ..." and mentions `text`.
-::testing::AssertionResult namesLine(const std::string& message, const fs::path& file,
-                                     std::size_t line, const std::string& text) {
-  const std::string where = file.string() + ":" + std::to_string(line) + ": ";
-  if (message.find(where) == std::string::npos) {
-    return ::testing::AssertionFailure() << "'" << message << "' lacks '" << where << "'";
-  }
-  if (message.find(text) == std::string::npos) {
-    return ::testing::AssertionFailure() << "'" << message << "' lacks '" << text << "'";
-  }
-  return ::testing::AssertionSuccess();
-}
 
 // A trajectory with awkward stamps (not multiples of a round step) and generic rotations.
 Trajectory sampleTrajectory() {
@@ -185,7 +164,7 @@ TEST_F(TrajectoryIoTest, RejectsKittiTimesCountMismatch) {
 TEST_F(TrajectoryIoTest, RejectsMalformedKittiTimes) {
   const fs::path file = write("d.kitti", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n");
   const fs::path times = write("bad_times.txt", "0.0\n0.1x\n");
-  EXPECT_TRUE(namesLine(inputError([&] { readKitti(file, times); }), times, 2, "malformed"));
+  EXPECT_TRUE(names(inputError([&] { readKitti(file, times); }), times, 2, "malformed"));
 }
 
 TEST_F(TrajectoryIoTest, RejectsTimesFileForOtherFormats) {
@@ -257,64 +236,63 @@ TEST_F(TrajectoryIoTest, WriterNamesMissingDirectory) {
 
 TEST_F(TrajectoryIoTest, RejectsTumWrongFieldCount) {
   const fs::path file = write("count.tum", "# header\n0 0 0 0 0 0 0 1\n1 0 0 0 0 0 1\n");
-  EXPECT_TRUE(namesLine(inputError([&] { readTum(file); }), file, 3, "expected 8 fields, got 7"));
+  EXPECT_TRUE(names(inputError([&] { readTum(file); }), file, 3, "expected 8 fields, got 7"));
 }
 
 TEST_F(TrajectoryIoTest, RejectsKittiWrongFieldCount) {
   const fs::path file = write("count.kitti", "1 0 0 0 0 1 0 0 0 0 1 0 7\n");
-  EXPECT_TRUE(
-      namesLine(inputError([&] { readKitti(file); }), file, 1, "expected 12 fields, got 13"));
+  EXPECT_TRUE(names(inputError([&] { readKitti(file); }), file, 1, "expected 12 fields, got 13"));
 }
 
 TEST_F(TrajectoryIoTest, RejectsEurocTooFewFields) {
   const fs::path file = write("count.csv", "#h\n1,0,0,0,1,0,0,0\n2,0,0,0,1,0,0\n");
-  EXPECT_TRUE(namesLine(inputError([&] { readEurocCsv(file); }), file, 3,
-                        "expected at least 8 fields, got 7"));
+  EXPECT_TRUE(
+      names(inputError([&] { readEurocCsv(file); }), file, 3, "expected at least 8 fields, got 7"));
 }
 
 TEST_F(TrajectoryIoTest, RejectsMalformedNumber) {
   const fs::path file = write("bad.tum", "0 0 0 0 0 0 0 1\n1 0 0 0.5x 0 0 0 1\n");
-  EXPECT_TRUE(namesLine(inputError([&] { readTum(file); }), file, 2, "malformed tz '0.5x'"));
+  EXPECT_TRUE(names(inputError([&] { readTum(file); }), file, 2, "malformed tz '0.5x'"));
 }
 
 TEST_F(TrajectoryIoTest, RejectsMalformedTimestamp) {
   const fs::path file = write("badt.csv", "12a4,0,0,0,1,0,0,0\n");
-  EXPECT_TRUE(namesLine(inputError([&] { readEurocCsv(file); }), file, 1, "malformed timestamp"));
+  EXPECT_TRUE(names(inputError([&] { readEurocCsv(file); }), file, 1, "malformed timestamp"));
 }
 
 TEST_F(TrajectoryIoTest, RejectsNan) {
   const fs::path file = write("nan.csv", "1,0,nan,0,1,0,0,0\n");
-  EXPECT_TRUE(namesLine(inputError([&] { readEurocCsv(file); }), file, 1, "p_y"));
+  EXPECT_TRUE(names(inputError([&] { readEurocCsv(file); }), file, 1, "p_y"));
 }
 
 TEST_F(TrajectoryIoTest, RejectsInf) {
   const fs::path file = write("inf.kitti", "1 0 0 0\t0 1 0 inf 0 0 1 0\n");
-  EXPECT_TRUE(namesLine(inputError([&] { readKitti(file); }), file, 1, "ty"));
+  EXPECT_TRUE(names(inputError([&] { readKitti(file); }), file, 1, "ty"));
 }
 
 TEST_F(TrajectoryIoTest, RejectsDecreasingTimestamp) {
   const fs::path file = write("dec.tum", "2 0 0 0 0 0 0 1\n\n1 0 0 0 0 0 0 1\n");
-  EXPECT_TRUE(namesLine(inputError([&] { readTum(file); }), file, 3,
-                        "timestamp not increasing (previous 2.000000000"));
+  EXPECT_TRUE(names(inputError([&] { readTum(file); }), file, 3,
+                    "timestamp not increasing (previous 2.000000000"));
 }
 
 TEST_F(TrajectoryIoTest, RejectsDuplicateTimestamp) {
   const fs::path file = write("dup.csv", "#h\n5,0,0,0,1,0,0,0\n6,0,0,0,1,0,0,0\n6,0,0,0,1,0,0,0\n");
-  EXPECT_TRUE(namesLine(inputError([&] { readEurocCsv(file); }), file, 4,
-                        "timestamp not increasing (previous 0.000000006"));
+  EXPECT_TRUE(names(inputError([&] { readEurocCsv(file); }), file, 4,
+                    "timestamp not increasing (previous 0.000000006"));
 }
 
 TEST_F(TrajectoryIoTest, RejectsUnnormalisedQuaternion) {
   const fs::path file = write("q.tum", "0 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1.01\n");
-  EXPECT_TRUE(namesLine(inputError([&] { readTum(file); }), file, 2,
-                        "quaternion not normalised (|q| = 1.01"));
+  EXPECT_TRUE(
+      names(inputError([&] { readTum(file); }), file, 2, "quaternion not normalised (|q| = 1.01"));
 }
 
 TEST_F(TrajectoryIoTest, RejectsNonRotationKitti) {
   const fs::path scaled = write("s.kitti", "1 0 0 0 0 1 0 0 0 0 1 0\n1.01 0 0 0 0 1 0 0 0 0 1 0\n");
-  EXPECT_TRUE(namesLine(inputError([&] { readKitti(scaled); }), scaled, 2, "not a rotation"));
+  EXPECT_TRUE(names(inputError([&] { readKitti(scaled); }), scaled, 2, "not a rotation"));
   const fs::path mirrored = write("m.kitti", "-1 0 0 0 0 1 0 0 0 0 1 0\n");
-  EXPECT_TRUE(namesLine(inputError([&] { readKitti(mirrored); }), mirrored, 1, "not a rotation"));
+  EXPECT_TRUE(names(inputError([&] { readKitti(mirrored); }), mirrored, 1, "not a rotation"));
 }
 
 TEST_F(TrajectoryIoTest, RejectsMissingFile) {
