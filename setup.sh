@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # gvio setup: installs exactly the Debian packages the project needs (apt-get update only when
 # something is missing), builds, and runs one of:
-#   ./setup.sh demo    the main job on the embedded demo drive (the default)
+#   ./setup.sh demo    the main job on the embedded demo input (the default)
 #   ./setup.sh test    every test (ctest); this is what CI runs
 #   ./setup.sh build   install + build only
 # Idempotent and non-interactive. Environment: BUILD_DIR (default build), JOBS (default nproc).
@@ -47,10 +47,11 @@ case "$mode" in
     ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS"
     ;;
   demo)
-    drive=assets/demo/2011_09_26/2011_09_26_drive_0001_extract
+    # Simulate 20 s of the embedded drive (stereo, IMU, SPP GNSS, exact truth), then validate it.
     mkdir -p out/demo
-    "$BUILD_DIR/app/gvio" inspect --dataset "$drive" --json out/demo/inspect.json
-    echo "setup: demo summary written to out/demo/inspect.json"
+    "$BUILD_DIR/app/gvio" simulate --trajectory assets/demo/drive.tum --seconds 20 --out out/demo/drive --force
+    "$BUILD_DIR/app/gvio" inspect --dataset out/demo/drive --json out/demo/inspect.json
+    echo "setup: demo drive in out/demo/drive, summary in out/demo/inspect.json"
     ;;
   *)
     echo "usage: ./setup.sh [demo|test|build]" >&2

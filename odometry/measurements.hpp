@@ -9,6 +9,9 @@
 
 namespace gvio {
 
+// Gravity magnitude used by the simulator and the estimators alike (local ENU: g_w = (0, 0, -g)).
+inline constexpr double kGravity_mps2 = 9.81;
+
 // Specific force and angular rate in the body (IMU) frame.
 struct ImuSample {
   std::int64_t t_ns = 0;

@@ -239,42 +239,57 @@ void GpuScene::uploadMeshes(const Scene& scene, float max_anisotropy) {
     textures_.push_back(std::move(tex));
     texture_grey_.push_back(t.channels == 1);
   }
+  // Meshes sharing a texture are batched into one buffer pair and one draw call: procedural worlds
+  // are made of thousands of small pieces.
+  struct Batch {
+    std::vector<float> vertices;  // x y z u v
+    std::vector<std::uint32_t> indices;
+  };
+  std::vector<Batch> batches(textures_.size());
   for (const auto& m : scene.meshes) {
     if (m.indices.empty()) continue;
     if (m.uv.size() != m.vertices.size() || m.texture >= textures_.size() ||
         m.indices.size() % 3 != 0) {
       throw RenderError("textured mesh: uv count, texture index or triangle count is inconsistent");
     }
-    std::vector<float> v;
-    v.reserve(m.vertices.size() * 5);
+    Batch& b = batches[m.texture];
+    const auto base = static_cast<std::uint32_t>(b.vertices.size() / 5);
     for (std::size_t i = 0; i < m.vertices.size(); ++i) {
       const Eigen::Vector3f p = (m.vertices[i] - origin_).cast<float>();
-      v.insert(v.end(), {p.x(), p.y(), p.z(), m.uv[i].x(), m.uv[i].y()});
+      b.vertices.insert(b.vertices.end(), {p.x(), p.y(), p.z(), m.uv[i].x(), m.uv[i].y()});
     }
     for (const auto idx : m.indices) {
       if (idx >= m.vertices.size()) throw RenderError("textured mesh: index out of range");
+      b.indices.push_back(base + idx);
     }
-    Mesh mesh;
-    mesh.vao = makeVertexArray();
-    mesh.vertices = makeBuffer();
-    mesh.indices = makeBuffer();
-    mesh.index_count = static_cast<GLsizei>(m.indices.size());
-    mesh.texture = m.texture;
-    glBindVertexArray(mesh.vao.get());
-    glBindBuffer(GL_ARRAY_BUFFER, mesh.vertices.get());
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(float)), v.data(),
-                 GL_STATIC_DRAW);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh.indices.get());
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER,
-                 static_cast<GLsizeiptr>(m.indices.size() * sizeof(std::uint32_t)),
-                 m.indices.data(), GL_STATIC_DRAW);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 5 * sizeof(float), nullptr);
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 5 * sizeof(float),
-                          reinterpret_cast<void*>(3 * sizeof(float)));
-    meshes_.push_back(std::move(mesh));
   }
+  for (std::size_t t = 0; t < batches.size(); ++t) {
+    if (!batches[t].indices.empty()) uploadBatch(batches[t].vertices, batches[t].indices, t);
+  }
+}
+
+void GpuScene::uploadBatch(const std::vector<float>& vertices,
+                           const std::vector<std::uint32_t>& indices, std::size_t texture) {
+  Mesh mesh;
+  mesh.vao = makeVertexArray();
+  mesh.vertices = makeBuffer();
+  mesh.indices = makeBuffer();
+  mesh.index_count = static_cast<GLsizei>(indices.size());
+  mesh.texture = texture;
+  glBindVertexArray(mesh.vao.get());
+  glBindBuffer(GL_ARRAY_BUFFER, mesh.vertices.get());
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(float)),
+               vertices.data(), GL_STATIC_DRAW);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh.indices.get());
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+               static_cast<GLsizeiptr>(indices.size() * sizeof(std::uint32_t)), indices.data(),
+               GL_STATIC_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 5 * sizeof(float), nullptr);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 5 * sizeof(float),
+                        reinterpret_cast<void*>(3 * sizeof(float)));
+  meshes_.push_back(std::move(mesh));
 }
 
 }  // namespace gvio::render

@@ -49,6 +49,8 @@ class GpuScene {
   void uploadPoints(const Scene& scene);
   void uploadVoxels(const Scene& scene);
   void uploadMeshes(const Scene& scene, float max_anisotropy);
+  void uploadBatch(const std::vector<float>& vertices, const std::vector<std::uint32_t>& indices,
+                   std::size_t texture);
 
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();  // vertices are stored relative to it (float)
   Eigen::AlignedBox3d bounds_;

@@ -76,6 +76,7 @@ int runMain(int argc, char** argv) {
   commands.push_back(addInspectCommand(app, common));
   commands.push_back(addEvalCommand(app));
   commands.push_back(addRenderCommand(app));
+  commands.push_back(addSimulateCommand(app, common));
 
   try {
     app.parse(argc, argv);

@@ -38,6 +38,7 @@ struct Command {
 Command addInspectCommand(CLI::App& app, const CommonOptions& common);
 Command addEvalCommand(CLI::App& app);
 Command addRenderCommand(CLI::App& app);
+Command addSimulateCommand(CLI::App& app, const CommonOptions& common);
 
 int runMain(int argc, char** argv);
 

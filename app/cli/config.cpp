@@ -43,6 +43,43 @@ ConfigKey boolean(std::string name, bool& field) {
           [&field] { return std::string(field ? "true" : "false"); }};
 }
 
+ConfigKey integer(std::string name, int& field) {
+  return {
+      name,
+      [name, &field](std::string_view v) {
+        const double d = parseDouble(name, v);
+        if (d != std::floor(d) || std::abs(d) > 1e9) {
+          throw InvalidInput(fmt::format("bad value '{}' for {}: expected an integer", v, name));
+        }
+        field = static_cast<int>(d);
+      },
+      [&field] { return std::to_string(field); }};
+}
+
+// Vectors are written "x,y,z" (a YAML sequence flattens to that form).
+ConfigKey vector3(std::string name, Eigen::Vector3d& field) {
+  return {
+      name,
+      [name, &field](std::string_view v) {
+        if (v.size() >= 2 && v.front() == '[' && v.back() == ']') v = v.substr(1, v.size() - 2);
+        Eigen::Vector3d out;
+        std::size_t start = 0;
+        for (int i = 0; i < 3; ++i) {
+          const auto comma = v.find(',', start);
+          if ((i < 2) != (comma != std::string_view::npos)) {
+            throw InvalidInput(fmt::format("bad value '{}' for {}: expected 3 numbers", v, name));
+          }
+          std::string_view part = v.substr(start, i < 2 ? comma - start : std::string_view::npos);
+          while (!part.empty() && part.front() == ' ') part.remove_prefix(1);
+          while (!part.empty() && part.back() == ' ') part.remove_suffix(1);
+          out[i] = parseDouble(name, part);
+          start = comma + 1;
+        }
+        field = out;
+      },
+      [&field] { return fmt::format("[{}, {}, {}]", field.x(), field.y(), field.z()); }};
+}
+
 ConfigKey text(std::string name, std::string& field) {
   return {name, [&field](std::string_view v) { field = std::string(v); },
           [&field] { return field; }};
@@ -119,6 +156,7 @@ void applyOverride(const std::string& assignment, std::map<std::string, ConfigKe
 void AppConfig::validate() const {
   dataset.validate();
   imu.noise.validate();
+  sim.validate();
 }
 
 std::vector<ConfigKey> configKeys(AppConfig& c) {
@@ -135,6 +173,24 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("imu.gyr_noise_density", c.imu.noise.gyr_noise_density),
       number("imu.acc_random_walk", c.imu.noise.acc_random_walk),
       number("imu.gyr_random_walk", c.imu.noise.gyr_random_walk),
+      number("sim.origin_lat_deg", c.sim.origin_lat_deg),
+      number("sim.origin_lon_deg", c.sim.origin_lon_deg),
+      number("sim.origin_h_m", c.sim.origin_h_m),
+      number("sim.heading_deg", c.sim.heading_deg),
+      number("sim.camera_rate_hz", c.sim.camera_rate_hz),
+      number("sim.imu_rate_hz", c.sim.imu_rate_hz),
+      number("sim.gnss_rate_hz", c.sim.gnss_rate_hz),
+      vector3("sim.gnss_lever_arm_m", c.sim.gnss_lever_arm_m),
+      number("sim.image_noise_dn", c.sim.image_noise_dn),
+      boolean("sim.exposure_change", c.sim.exposure_change),
+      number("sim.exposure_amplitude", c.sim.exposure_amplitude),
+      number("sim.exposure_period_s", c.sim.exposure_period_s),
+      boolean("sim.motion_blur", c.sim.motion_blur),
+      number("sim.exposure_time_s", c.sim.exposure_time_s),
+      integer("sim.blur_samples", c.sim.blur_samples),
+      number("sim.knot_spacing_s", c.sim.knot_spacing_s),
+      number("sim.smoothing", c.sim.smoothing),
+      integer("sim.texture_size_px", c.sim.texture_size_px),
   };
 }
 
@@ -162,7 +218,8 @@ std::string dumpConfigYaml(const AppConfig& config) {
       out << YAML::Key << head << YAML::Value << YAML::BeginMap;
       section = head;
     }
-    out << YAML::Key << key.name.substr(dot + 1) << YAML::Value << key.get();
+    // Values go through the YAML parser so lists stay lists and numbers stay unquoted.
+    out << YAML::Key << key.name.substr(dot + 1) << YAML::Value << YAML::Load(key.get());
   }
   if (!section.empty()) out << YAML::EndMap;
   out << YAML::EndMap;

@@ -10,6 +10,7 @@
 
 #include "io/reader_config.hpp"
 #include "odometry/measurements.hpp"
+#include "sim/sim_config.hpp"
 
 namespace gvio::cli {
 
@@ -22,6 +23,7 @@ struct ImuConfig {
 struct AppConfig {
   io::ReaderConfig dataset;
   ImuConfig imu;
+  sim::SimConfig sim;
 
   void validate() const;  // throws InvalidInput naming the key
 };

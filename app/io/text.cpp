@@ -1,5 +1,7 @@
 #include "io/text.hpp"
 
+#include <fmt/format.h>
+
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -156,6 +158,30 @@ std::int64_t daysFromCivil(int year, unsigned month, unsigned day) {
   const unsigned doy = (153 * (month + (month > 2 ? -3 : 9)) + 2) / 5 + day - 1;
   const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
   return static_cast<std::int64_t>(era) * 146097 + static_cast<std::int64_t>(doe) - 719468;
+}
+
+CivilDate civilFromDays(std::int64_t days) {
+  days += 719468;
+  const std::int64_t era = (days >= 0 ? days : days - 146096) / 146097;
+  const auto doe = static_cast<unsigned>(days - era * 146097);
+  const unsigned yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
+  const unsigned doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+  const unsigned mp = (5 * doy + 2) / 153;
+  CivilDate d;
+  d.day = doy - (153 * mp + 2) / 5 + 1;
+  d.month = mp < 10 ? mp + 3 : mp - 9;
+  d.year = static_cast<int>(static_cast<std::int64_t>(yoe) + era * 400 + (d.month <= 2 ? 1 : 0));
+  return d;
+}
+
+std::string formatKittiTimestamp(std::int64_t t_ns) {
+  constexpr std::int64_t kDayNs = 86'400'000'000'000LL;
+  const std::int64_t days = (t_ns >= 0 ? t_ns : t_ns - kDayNs + 1) / kDayNs;
+  const std::int64_t in_day = t_ns - days * kDayNs;
+  const CivilDate d = civilFromDays(days);
+  const std::int64_t s = in_day / 1'000'000'000LL;
+  return fmt::format("{:04d}-{:02d}-{:02d} {:02d}:{:02d}:{:02d}.{:09d}", d.year, d.month, d.day,
+                     s / 3600, (s / 60) % 60, s % 60, in_day % 1'000'000'000LL);
 }
 
 bool kittiTimestampToNs(std::string_view text, std::int64_t& t_ns) {

@@ -53,6 +53,16 @@ bool kittiTimestampToNs(std::string_view text, std::int64_t& t_ns);
 // Days since 1970-01-01 of a proleptic Gregorian date (H. Hinnant's days_from_civil).
 std::int64_t daysFromCivil(int year, unsigned month, unsigned day);
 
+struct CivilDate {
+  int year = 1970;
+  unsigned month = 1, day = 1;
+};
+// The inverse (H. Hinnant's civil_from_days).
+CivilDate civilFromDays(std::int64_t days);
+
+// UTC nanoseconds as KITTI writes timestamps.txt: "YYYY-MM-DD hh:mm:ss.fffffffff".
+std::string formatKittiTimestamp(std::int64_t t_ns);
+
 // Nanoseconds as decimal seconds with 9 fractional digits, exact.
 std::string formatSeconds(std::int64_t t_ns);
 

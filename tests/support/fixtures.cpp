@@ -13,6 +13,7 @@
 
 #include "io/nmea.hpp"
 #include "io/text.hpp"
+#include "sim/kitti_convention.hpp"
 
 namespace gvio::test {
 namespace fs = std::filesystem;
@@ -54,33 +55,18 @@ void replaceLine(const fs::path& file, std::size_t line, const std::string& text
 
 namespace {
 
-// Real KITTI 2011_09_26 IMU->velodyne->camera extrinsics; intrinsics scaled to the tiny images.
+// KITTI's real IMU -> velodyne -> camera chain with intrinsics scaled to the tiny images.
 void writeCalib(const fs::path& dir, const KittiFixture& s) {
-  writeText(dir / "calib_imu_to_velo.txt",
-            "calib_time: 25-May-2012 16:47:16\n"
-            "R: 9.999976e-01 7.553071e-04 -2.035826e-03 -7.854027e-04 9.998898e-01 -1.482298e-02 "
-            "2.024406e-03 1.482454e-02 9.998881e-01\n"
-            "T: -8.086759e-01 3.195559e-01 -7.997231e-01\n");
-  writeText(dir / "calib_velo_to_cam.txt",
-            "calib_time: 15-Mar-2012 11:37:16\n"
-            "R: 7.533745e-03 -9.999714e-01 -6.166020e-04 1.480249e-02 7.280733e-04 -9.998902e-01 "
-            "9.998621e-01 7.523790e-03 1.480755e-02\n"
-            "T: -4.069766e-03 -7.631618e-02 -2.717806e-01\n"
-            "delta_f: 0.000000e+00 0.000000e+00\ndelta_c: 0.000000e+00 0.000000e+00\n");
-  const double f = 0.5 * s.width, cx = 0.5 * s.width, cy = 0.5 * s.height;
-  std::string c2c = "calib_time: 09-Jan-2012 13:57:47\ncorner_dist: 9.950000e-02\n";
-  for (int id = 0; id < 2; ++id) {
-    const double tx = id == 0 ? 0.0 : -0.537;
-    c2c += fmt::format("S_{:02d}: {} {}\n", id, s.width, s.height);
-    c2c += fmt::format("K_{:02d}: {} 0 {} 0 {} {} 0 0 1\n", id, f, cx, f, cy);
-    c2c += fmt::format("D_{:02d}: 0 0 0 0 0\n", id);
-    c2c += fmt::format("R_{:02d}: 1 0 0 0 1 0 0 0 1\n", id);
-    c2c += fmt::format("T_{:02d}: {} 0 0\n", id, tx);
-    c2c += fmt::format("S_rect_{:02d}: {} {}\n", id, s.width, s.height);
-    c2c += fmt::format("R_rect_{:02d}: 1 0 0 0 1 0 0 0 1\n", id);
-    c2c += fmt::format("P_rect_{:02d}: {} 0 {} {} 0 {} {} 0 0 0 1 0\n", id, f, cx, f * tx, f, cy);
-  }
-  writeText(dir / "calib_cam_to_cam.txt", c2c);
+  render::PinholeIntrinsics K;
+  K.fx = K.fy = 0.5 * s.width;
+  K.cx = 0.5 * s.width;
+  K.cy = 0.5 * s.height;
+  K.width = s.width;
+  K.height = s.height;
+  const sim::KittiCalibrationText text = sim::kittiCalibrationText(K, true);
+  writeText(dir / "calib_imu_to_velo.txt", text.imu_to_velo);
+  writeText(dir / "calib_velo_to_cam.txt", text.velo_to_cam);
+  writeText(dir / "calib_cam_to_cam.txt", text.cam_to_cam);
 }
 
 std::string kittiStamp(std::int64_t t_ns_of_day) {
@@ -199,6 +185,24 @@ KittiFixture demoFixture() {
   spec.nmea_rate_hz = 5;
   spec.write_groundtruth = true;
   return spec;
+}
+
+Trajectory demoDrive() {
+  Trajectory t;
+  double x = 0, y = 0, yaw = 0;
+  for (int i = 0; i <= 350; ++i) {
+    const double s = 0.1 * i;
+    const double yaw_rate = (s > 10 && s < 14) ? 0.39 : ((s > 22 && s < 26) ? -0.39 : 0.0);
+    yaw += 0.1 * yaw_rate;
+    x += 0.8 * std::cos(yaw);
+    y += 0.8 * std::sin(yaw);
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    T.translation() = Eigen::Vector3d(x, y, 0.93 + 0.2 * std::sin(0.05 * s));
+    t.poses.push_back(T);
+    t.t_ns.push_back(static_cast<std::int64_t>(i) * 100'000'000LL);
+  }
+  return t;
 }
 
 fs::path sharedData(const std::string& relative) {

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "odometry/trajectory.hpp"
+
 namespace gvio::test {
 
 // A fresh folder under the system temp dir, removed with its contents on destruction.
@@ -42,6 +44,11 @@ std::filesystem::path writeKittiFixture(const std::filesystem::path& base,
 
 // The embedded demo drive (assets/demo): 2 s, stereo 64x24, 100 Hz oxts, 5 Hz NMEA, truth.
 KittiFixture demoFixture();
+
+// A 35 s urban drive at 8 m/s with two 90-degree turns: body poses (x forward, z up) in a local
+// ENU frame at 10 Hz, stamps from 0. The demo's and the simulator tests' input
+// (assets/demo/drive.tum).
+Trajectory demoDrive();
 
 // Path of the real data folder (../shared/data beside the project), empty when absent.
 std::filesystem::path sharedData(const std::string& relative);

@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <set>
 
+#include "io/trajectory_io.hpp"
 #include "support/fixtures.hpp"
 
 namespace gvio::test {
@@ -24,6 +25,7 @@ TEST(DemoAssets, MatchGenerator) {
   const fs::path committed = fs::path(GVIO_SOURCE_DIR) / "assets" / "demo";
   TempDir tmp("demo");
   writeKittiFixture(tmp.path(), demoFixture());
+  io::writeTum(tmp.path() / "drive.tum", demoDrive());
   const auto expected = relativeFiles(tmp.path());
   ASSERT_EQ(relativeFiles(committed), expected)
       << "regenerate with build/tests/gvio_make_fixture assets/demo";

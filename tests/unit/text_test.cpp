@@ -51,6 +51,20 @@ TEST(Text, KittiTimestamps) {
   }
 }
 
+TEST(Text, KittiTimestampsRoundTrip) {
+  for (const std::int64_t t : {0LL, 1317042145594360375LL, 951782400123456789LL /* 2000-02-29 */,
+                               4102444799999999999LL /* 2099-12-31 23:59:59.999999999 */}) {
+    std::int64_t back = 0;
+    ASSERT_TRUE(kittiTimestampToNs(formatKittiTimestamp(t), back)) << formatKittiTimestamp(t);
+    EXPECT_EQ(back, t);
+  }
+  EXPECT_EQ(formatKittiTimestamp(1317042145594360375LL), "2011-09-26 13:02:25.594360375");
+  for (std::int64_t days = -800; days < 800000; days += 997) {
+    const CivilDate d = civilFromDays(days);
+    EXPECT_EQ(daysFromCivil(d.year, d.month, d.day), days);
+  }
+}
+
 TEST(Text, Splitting) {
   EXPECT_EQ(splitDelimited(" a, b ,,c", ','), (std::vector<std::string_view>{"a", "b", "", "c"}));
   EXPECT_EQ(splitWhitespace("  1 \t2   3 "), (std::vector<std::string_view>{"1", "2", "3"}));

@@ -1,0 +1,69 @@
+#include "io/mesh_ply.hpp"
+
+#include <pcl/PolygonMesh.h>
+#include <pcl/conversions.h>
+#include <pcl/io/ply_io.h>
+#include <pcl/point_types.h>
+#include <unistd.h>
+
+#include "io/input_error.hpp"
+
+namespace gvio::io {
+
+void writeMeshPly(const std::filesystem::path& file, const TriangleMesh& mesh) {
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  cloud.reserve(mesh.vertices.size());
+  for (const auto& v : mesh.vertices) {
+    cloud.emplace_back(static_cast<float>(v.x()), static_cast<float>(v.y()),
+                       static_cast<float>(v.z()));
+  }
+  pcl::PolygonMesh pm;
+  pcl::toPCLPointCloud2(cloud, pm.cloud);
+  pm.polygons.reserve(mesh.triangles.size());
+  for (const auto& t : mesh.triangles) {
+    pcl::Vertices face;
+    for (const std::uint32_t idx : t) face.vertices.push_back(static_cast<pcl::index_t>(idx));
+    pm.polygons.push_back(face);
+  }
+  // PCL writes to a path; write a temporary sibling and rename it into place.
+  const std::filesystem::path tmp =
+      file.string() + ".tmp" + std::to_string(static_cast<long>(::getpid())) + ".ply";
+  if (pcl::io::savePLYFileBinary(tmp.string(), pm) != 0) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw InputError(file, 0, "cannot write (missing directory or no permission)");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, file, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw InputError(file, 0, "cannot rename temporary file into place");
+  }
+}
+
+TriangleMesh readMeshPly(const std::filesystem::path& file) {
+  if (!std::filesystem::is_regular_file(file)) throw InputError(file, 0, "file not found");
+  pcl::PolygonMesh pm;
+  if (pcl::io::loadPLYFile(file.string(), pm) != 0)
+    throw InputError(file, 0, "not a readable PLY mesh");
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  pcl::fromPCLPointCloud2(pm.cloud, cloud);
+  TriangleMesh mesh;
+  for (const auto& p : cloud) mesh.vertices.emplace_back(p.x, p.y, p.z);
+  for (const auto& poly : pm.polygons) {
+    if (poly.vertices.size() != 3) throw InputError(file, 0, "faces must be triangles");
+    std::array<std::uint32_t, 3> tri{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto idx = poly.vertices[k];
+      if (idx < 0 || static_cast<std::size_t>(idx) >= mesh.vertices.size()) {
+        throw InputError(file, 0, "face index out of range");
+      }
+      tri[k] = static_cast<std::uint32_t>(idx);
+    }
+    mesh.triangles.push_back(tri);
+  }
+  if (mesh.triangles.empty()) throw InputError(file, 0, "no triangle faces");
+  return mesh;
+}
+
+}  // namespace gvio::io

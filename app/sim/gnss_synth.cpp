@@ -1,0 +1,276 @@
+#include "sim/gnss_synth.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "io/nmea.hpp"
+#include "odometry/error.hpp"
+#include "sim/rng.hpp"
+
+namespace gvio::sim {
+namespace {
+
+constexpr std::int64_t kNsPerSecond = 1'000'000'000;
+constexpr std::int64_t kNsPerDay = 86'400 * kNsPerSecond;
+// GGA altitude is above the geoid; the simulator has no geoid model, so it writes a constant
+// separation and the altitude that makes altitude + separation the simulated ellipsoidal height.
+constexpr double kGeoidSeparationM = 47.0;
+// Period of the slow HDOP / satellite-count variation (constellation geometry changes in minutes).
+constexpr double kGeometryPeriodS = 900.0;
+
+// One receiver error model of the issue, all values 1-sigma in metres.
+struct ErrorModel {
+  double white_h_m = 0.0;  // white noise per horizontal axis (east, north)
+  double white_v_m = 0.0;  // white noise, up
+  double bias_m = 0.0;     // steady-state sigma of the Gauss-Markov bias per axis (0: no bias)
+  double bias_tau_s = 60.0;
+  double outlier_probability = 0.0;
+  double outlier_min_m = 5.0, outlier_max_m = 30.0;
+  // What the receiver reports: it knows its white noise, not the bias or the outliers.
+  double reported_sigma_h_m = 0.0, reported_sigma_v_m = 0.0;
+  int quality = 1;
+  double hdop_min = 0.0, hdop_max = 0.0;
+  int sats_min = 0, sats_max = 0;
+};
+
+ErrorModel modelFor(GnssNoise noise) {
+  ErrorModel m;
+  switch (noise) {
+    case GnssNoise::kNone:
+      // Exact positions, yet tiny positive sigmas: readers reject non-positive ones.
+      m.reported_sigma_h_m = 0.01;
+      m.reported_sigma_v_m = 0.02;
+      m.quality = 4;
+      m.hdop_min = 0.6, m.hdop_max = 0.9, m.sats_min = 14, m.sats_max = 20;
+      break;
+    case GnssNoise::kRtk:
+      m.white_h_m = m.reported_sigma_h_m = 0.02;
+      m.white_v_m = m.reported_sigma_v_m = 0.04;
+      m.quality = 4;  // RTK fixed
+      m.hdop_min = 0.6, m.hdop_max = 0.9, m.sats_min = 14, m.sats_max = 20;
+      break;
+    case GnssNoise::kSpp:
+      m.white_h_m = m.reported_sigma_h_m = 1.5;
+      m.white_v_m = m.reported_sigma_v_m = 3.0;
+      m.bias_m = 1.0;
+      m.outlier_probability = 0.01;
+      m.quality = 1;
+      m.hdop_min = 0.8, m.hdop_max = 2.0, m.sats_min = 7, m.sats_max = 12;
+      break;
+  }
+  return m;
+}
+
+std::int64_t periodNs(double rate_hz) {
+  if (rate_hz != 1.0 && rate_hz != 5.0 && rate_hz != 10.0) {
+    throw InvalidInput(fmt::format("GNSS rate must be 1, 5 or 10 Hz (got {})", rate_hz));
+  }
+  return static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
+}
+
+bool inOutage(std::int64_t t_ns, const GnssSimOptions& options) {
+  for (const auto& [a, b] : options.outages_ns) {
+    if (t_ns >= a && t_ns <= b) return true;
+  }
+  return false;
+}
+
+// Exact discretisation of a first-order Gauss-Markov process over dt: b' = phi b + sqrt(1 - phi^2)
+// sigma w with phi = exp(-dt/tau). It keeps the stationary variance sigma^2 for any dt, so gaps
+// from outages need no special case.
+Eigen::Vector3d propagateBias(const Eigen::Vector3d& bias, double dt_s, const ErrorModel& m,
+                              Rng& rng) {
+  const double phi = std::exp(-dt_s / m.bias_tau_s);
+  return phi * bias + std::sqrt(1.0 - phi * phi) * m.bias_m * rng.normal3();
+}
+
+// An outlier (multipath, wrong ambiguity): uniform magnitude in a random direction, the vertical
+// component halved before normalising because such errors are mostly horizontal.
+Eigen::Vector3d outlierError(const ErrorModel& m, Rng& rng) {
+  Eigen::Vector3d direction = rng.normal3();
+  direction.z() *= 0.5;
+  return rng.uniform(m.outlier_min_m, m.outlier_max_m) * direction.normalized();
+}
+
+struct Geometry {
+  double hdop = 0.0;
+  int num_sats = 0;
+};
+
+// HDOP and the satellite count follow the constellation geometry: one slow sinusoid (random phase)
+// drives both, fewer satellites going with a higher HDOP. HDOP is rounded to the 0.1 that GGA
+// carries, so a written and re-read log reproduces it.
+Geometry geometryAt(const ErrorModel& m, double t_s, double phase) {
+  const double poor = 0.5 + 0.5 * std::sin(2.0 * std::numbers::pi * t_s / kGeometryPeriodS + phase);
+  Geometry g;
+  g.hdop = std::round((m.hdop_min + poor * (m.hdop_max - m.hdop_min)) * 10.0) / 10.0;
+  g.num_sats = m.sats_max - static_cast<int>(std::lround(poor * (m.sats_max - m.sats_min)));
+  return g;
+}
+
+// The state that carries from one fix to the next.
+struct ReceiverState {
+  Eigen::Vector3d bias = Eigen::Vector3d::Zero();
+  std::int64_t t_ns = 0;
+  double phase = 0.0;
+};
+
+// Error of one fix (ENU, metres); sets `outlier`. Draws nothing for an error-free model.
+Eigen::Vector3d drawError(std::int64_t t_ns, const ErrorModel& m, ReceiverState& state, Rng& rng,
+                          bool& outlier) {
+  Eigen::Vector3d error = Eigen::Vector3d::Zero();
+  if (m.bias_m > 0.0) {
+    const double dt_s = static_cast<double>(t_ns - state.t_ns) * 1e-9;
+    state.bias = propagateBias(state.bias, dt_s, m, rng);
+    error += state.bias;
+  }
+  state.t_ns = t_ns;
+  if (m.white_h_m > 0.0 || m.white_v_m > 0.0) {
+    error += rng.normal3().cwiseProduct(Eigen::Vector3d(m.white_h_m, m.white_h_m, m.white_v_m));
+  }
+  outlier = m.outlier_probability > 0.0 && rng.uniform() < m.outlier_probability;
+  if (outlier) error += outlierError(m, rng);
+  return error;
+}
+
+GnssFix reportedFix(std::int64_t t_ns, const Eigen::Vector3d& p_enu, const Geometry& geometry,
+                    const ErrorModel& m, const fusion::EnuFrame& enu) {
+  const fusion::Lla lla = enu.toLla(p_enu);
+  GnssFix fix;
+  fix.t_ns = t_ns;
+  fix.lat_deg = lla.lat_deg;
+  fix.lon_deg = lla.lon_deg;
+  fix.h_ellipsoid_m = lla.h_ellipsoid_m;
+  fix.sigma_h_m = m.reported_sigma_h_m;
+  fix.sigma_v_m = m.reported_sigma_v_m;
+  fix.quality = m.quality;
+  fix.hdop = geometry.hdop;
+  fix.num_sats = geometry.num_sats;
+  return fix;
+}
+
+// "hhmmss.ss" UTC; more decimals (up to 9) only when the time is not on a 10 ms grid, so any
+// nanosecond time stamp survives a write/read round trip.
+std::string timeOfDay(std::int64_t t_ns) {
+  const std::int64_t tod = ((t_ns % kNsPerDay) + kNsPerDay) % kNsPerDay;
+  const std::int64_t s = tod / kNsPerSecond;
+  std::string text =
+      fmt::format("{:02}{:02}{:02}.{:09}", s / 3600, s / 60 % 60, s % 60, tod % kNsPerSecond);
+  while (text.size() > 9 && text.back() == '0') text.pop_back();
+  return text;
+}
+
+// "ddmmyy" UTC of a Unix time (H. Hinnant's civil_from_days, the inverse of io::daysFromCivil).
+std::string dateOf(std::int64_t t_ns) {
+  const std::int64_t days = (t_ns >= 0 ? t_ns : t_ns - kNsPerDay + 1) / kNsPerDay;
+  const std::int64_t z = days + 719468;
+  const std::int64_t era = (z >= 0 ? z : z - 146096) / 146097;
+  const std::int64_t doe = z - era * 146097;
+  const std::int64_t yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
+  const std::int64_t doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+  const std::int64_t mp = (5 * doy + 2) / 153;
+  const std::int64_t day = doy - (153 * mp + 2) / 5 + 1;
+  const std::int64_t month = mp < 10 ? mp + 3 : mp - 9;
+  const std::int64_t year = yoe + era * 400 + (month <= 2 ? 1 : 0);
+  return fmt::format("{:02}{:02}{:02}", day, month, ((year % 100) + 100) % 100);
+}
+
+// "ddmm.mmmmmmm,N" / "dddmm.mmmmmmm,E": minutes rounded to 1e-7 (0.2 mm) in integers, so rounding
+// up to 60 minutes carries into the degrees instead of printing "60.0000000".
+std::string coordinate(double deg, int degree_digits, char positive, char negative) {
+  constexpr std::int64_t kUnitsPerMinute = 10'000'000;
+  const std::int64_t units = std::llround(std::abs(deg) * 60.0 * kUnitsPerMinute);
+  const std::int64_t minutes = units % (60 * kUnitsPerMinute);
+  return fmt::format("{:0{}}{:02}.{:07},{}", units / (60 * kUnitsPerMinute), degree_digits,
+                     minutes / kUnitsPerMinute, minutes % kUnitsPerMinute,
+                     deg < 0.0 ? negative : positive);
+}
+
+std::string latLon(const GnssFix& fix) {
+  return coordinate(fix.lat_deg, 2, 'N', 'S') + "," + coordinate(fix.lon_deg, 3, 'E', 'W');
+}
+
+std::string ggaBody(const GnssFix& fix, const std::string& time) {
+  return fmt::format("GPGGA,{},{},{},{:02},{:.1f},{:.3f},M,{:.3f},M,,", time, latLon(fix),
+                     fix.quality, fix.num_sats, fix.hdop, fix.h_ellipsoid_m - kGeoidSeparationM,
+                     kGeoidSeparationM);
+}
+
+// Speed and course are not known from positions alone; 0.0 is a valid value for both.
+std::string rmcBody(const GnssFix& fix, const std::string& time) {
+  return fmt::format("GPRMC,{},A,{},0.0,0.0,{},,,A", time, latLon(fix), dateOf(fix.t_ns));
+}
+
+// The shortest text that reads back as the same double ("1.5", "0.02"), with a decimal point kept
+// ("3.0", not "3") as NMEA fields usually show one.
+std::string exactDecimal(double value) {
+  std::string text = fmt::format("{}", value);
+  if (text.find_first_of(".e") == std::string::npos) text += ".0";
+  return text;
+}
+
+// GST carries the sigmas GGA lacks (rms, error ellipse, lat/lon/alt sigma), written exactly so a
+// reader recovers the reported sigmas; the ellipse is a circle of the horizontal sigma.
+std::string gstBody(const GnssFix& fix, const std::string& time) {
+  const std::string h = exactDecimal(fix.sigma_h_m);
+  return fmt::format("GPGST,{},{},{},{},0.0,{},{},{}", time, h, h, h, h, h,
+                     exactDecimal(fix.sigma_v_m));
+}
+
+}  // namespace
+
+GnssNoise parseGnssNoise(const std::string& name) {
+  if (name == "none") return GnssNoise::kNone;
+  if (name == "rtk") return GnssNoise::kRtk;
+  if (name == "spp") return GnssNoise::kSpp;
+  throw InvalidInput("unknown GNSS noise model '" + name + "' (expected none, rtk or spp)");
+}
+
+std::vector<GnssSimFix> synthesizeGnss(
+    const std::function<Eigen::Isometry3d(std::int64_t)>& T_w_b_at, std::int64_t t0_ns,
+    std::int64_t t1_ns, const fusion::EnuFrame& enu, const GnssSimOptions& options,
+    std::uint64_t seed) {
+  const std::int64_t period_ns = periodNs(options.rate_hz);
+  const ErrorModel model = modelFor(options.noise);
+  Rng rng(seed);
+  ReceiverState state;
+  state.t_ns = t0_ns;
+  state.phase = rng.uniform(0.0, 2.0 * std::numbers::pi);
+  state.bias = model.bias_m * rng.normal3();  // drawn from the stationary distribution
+  std::vector<GnssSimFix> fixes;
+  for (std::int64_t t_ns = t0_ns; t_ns <= t1_ns; t_ns += period_ns) {
+    if (inOutage(t_ns, options)) continue;
+    GnssSimFix sim;
+    sim.p_enu_true = T_w_b_at(t_ns) * options.lever_arm_b;
+    sim.error_enu = drawError(t_ns, model, state, rng, sim.outlier);
+    const double t_s = static_cast<double>(t_ns - t0_ns) * 1e-9;
+    sim.fix = reportedFix(t_ns, sim.p_enu_true + sim.error_enu, geometryAt(model, t_s, state.phase),
+                          model, enu);
+    fixes.push_back(sim);
+  }
+  return fixes;
+}
+
+std::string toNmeaLog(const std::vector<GnssFix>& fixes) {
+  std::string log;
+  for (const GnssFix& fix : fixes) {
+    const std::string time = timeOfDay(fix.t_ns);
+    for (const std::string& body : {ggaBody(fix, time), rmcBody(fix, time), gstBody(fix, time)}) {
+      log += io::withNmeaChecksum(body) + "\r\n";
+    }
+  }
+  return log;
+}
+
+std::string toGnssCsv(const std::vector<GnssFix>& fixes) {
+  std::string csv = "#timestamp [ns],lat_deg,lon_deg,height_m,sigma_h_m,sigma_v_m\n";
+  for (const GnssFix& f : fixes) {
+    csv += fmt::format("{},{:.10f},{:.10f},{:.4f},{:.4f},{:.4f}\n", f.t_ns, f.lat_deg, f.lon_deg,
+                       f.h_ellipsoid_m, f.sigma_h_m, f.sigma_v_m);
+  }
+  return csv;
+}
+
+}  // namespace gvio::sim

@@ -1,0 +1,30 @@
+#pragma once
+// IMU measurements from a continuous trajectory: specific force f_b = R_w_b^T (a_w - g_w) and body
+// rate, plus white noise and bias random walk (continuous-time densities, discretised at the rate).
+#include <cstdint>
+#include <vector>
+
+#include "odometry/measurements.hpp"
+#include "sim/trajectory_fit.hpp"
+
+namespace gvio::sim {
+
+struct ImuSimSample {
+  ImuSample measured;  // what the sensor outputs (noise and bias included)
+  ImuSample truth;     // noise-free specific force and rate
+  Eigen::Vector3d acc_bias = Eigen::Vector3d::Zero(), gyr_bias = Eigen::Vector3d::Zero();
+};
+
+struct ImuSimOptions {
+  double rate_hz = 100.0;
+  ImuNoise noise;         // densities; all zero = noise-free
+  bool add_noise = true;  // false: measured == truth, biases zero
+  Eigen::Vector3d initial_acc_bias = Eigen::Vector3d::Zero();
+  Eigen::Vector3d initial_gyr_bias = Eigen::Vector3d::Zero();
+};
+
+// Samples [t0, t1] of `trajectory` at the rate; deterministic for a seed.
+std::vector<ImuSimSample> synthesizeImu(const ContinuousTrajectory& trajectory,
+                                        const ImuSimOptions& options, std::uint64_t seed);
+
+}  // namespace gvio::sim

@@ -1,0 +1,35 @@
+#pragma once
+// Simulator settings (YAML section `sim:`), plain struct with defaults. Per-run choices that users
+// vary every time (duration, GNSS grade, outages, seed, output format) are CLI flags instead.
+#include <Eigen/Core>
+
+#include "odometry/measurements.hpp"
+
+namespace gvio::sim {
+
+struct SimConfig {
+  // Geodetic origin of the local ENU frame (KITTI 00's first GPS fix).
+  double origin_lat_deg = 48.98253, origin_lon_deg = 8.39035, origin_h_m = 116.4;
+  // Heading of the KITTI world's forward (camera z) axis in ENU, degrees counter-clockwise from
+  // east.
+  double heading_deg = 0.0;
+  double camera_rate_hz = 10.0;
+  double imu_rate_hz = 100.0;
+  double gnss_rate_hz = 1.0;  // 1, 5 or 10
+  Eigen::Vector3d gnss_lever_arm_m{0.0, 0.0,
+                                   0.8};  // antenna in the body frame (x fwd, y left, z up)
+  double image_noise_dn = 2.0;            // Gaussian pixel noise, digital numbers (1 sigma)
+  bool exposure_change = false;           // slow sinusoidal gain change
+  double exposure_amplitude = 0.15;       // relative gain amplitude
+  double exposure_period_s = 20.0;
+  bool motion_blur = false;
+  double exposure_time_s = 0.004;  // blur integrates over this interval
+  int blur_samples = 4;            // renders averaged per blurred frame
+  double knot_spacing_s = 0.25;    // trajectory spline
+  double smoothing = 1e-2;
+  int texture_size_px = 512;
+
+  void validate() const;  // throws InvalidInput naming the key
+};
+
+}  // namespace gvio::sim

@@ -1,0 +1,270 @@
+#include "sim/simulator.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+#include <yaml-cpp/yaml.h>
+
+#include "io/atomic_write.hpp"
+#include "io/input_error.hpp"
+#include "io/kitti_calib.hpp"
+#include "io/mesh_ply.hpp"
+#include "io/text.hpp"
+#include "io/trajectory_io.hpp"
+#include "sim/camera_sim.hpp"
+#include "sim/dataset_writers.hpp"
+#include "sim/imu_synth.hpp"
+#include "sim/kitti_convention.hpp"
+#include "sim/world.hpp"
+
+namespace gvio::sim {
+namespace fs = std::filesystem;
+namespace {
+
+// Relative stamps (KITTI odometry times from 0) start at KITTI 00's recording time.
+constexpr std::int64_t kDefaultStartNs = 1317646534000000000LL;  // 2011-10-03 12:55:34 UTC
+constexpr std::int64_t kAbsoluteAfterNs = 1'000'000'000LL * 1'000'000'000LL;  // 2001-09-09
+
+// Everything the simulator writes, removed first with --force (nothing else is touched).
+const char* const kOwnedPaths[] = {"image_00",
+                                   "image_01",
+                                   "oxts",
+                                   "gnss",
+                                   "world",
+                                   "mav0",
+                                   "calib_cam_to_cam.txt",
+                                   "calib_imu_to_velo.txt",
+                                   "calib_velo_to_cam.txt",
+                                   "groundtruth.tum",
+                                   "sim.yaml"};
+
+void prepareOutput(const SimRequest& r) {
+  if (fs::exists(r.out) && !fs::is_directory(r.out))
+    throw io::InputError(r.out, 0, "exists and is not a folder");
+  if (fs::is_directory(r.out) && !fs::is_empty(r.out)) {
+    if (!r.force)
+      throw io::InputError(r.out, 0, "output folder is not empty (use --force to overwrite)");
+    for (const char* p : kOwnedPaths) fs::remove_all(r.out / p);
+  }
+  std::error_code ec;
+  fs::create_directories(r.out, ec);
+  if (ec) throw io::InputError(r.out, 0, "cannot create the output folder: " + ec.message());
+}
+
+Trajectory loadBodyPoses(const SimRequest& r, const SimConfig& c) {
+  const io::TrajectoryFormat f = r.trajectory_format == "auto"
+                                     ? io::detectTrajectoryFormat(r.trajectory)
+                                     : *io::parseTrajectoryFormat(r.trajectory_format);
+  if (f == io::TrajectoryFormat::kKitti && !r.times) {
+    throw InvalidInput("--trajectory " + r.trajectory.string() +
+                       " is KITTI: give its --times file");
+  }
+  Trajectory poses = io::readTrajectory(r.trajectory, f,
+                                        f == io::TrajectoryFormat::kKitti ? r.times : std::nullopt);
+  if (poses.size() < 4)
+    throw io::InputError(r.trajectory, 0,
+                         fmt::format("{} poses; at least 4 are needed", poses.size()));
+  if (f == io::TrajectoryFormat::kKitti) poses = kittiCameraToEnuBody(poses, c.heading_deg);
+  if (poses.t_ns.front() < kAbsoluteAfterNs) {
+    const std::int64_t shift = kDefaultStartNs - poses.t_ns.front();
+    for (auto& t : poses.t_ns) t += shift;
+  }
+  return poses;
+}
+
+std::vector<Eigen::Vector3d> routeOf(const ContinuousTrajectory& traj, std::int64_t t1_ns,
+                                     double& length_m) {
+  std::vector<Eigen::Vector3d> route;
+  length_m = 0.0;
+  for (std::int64_t t = traj.t0_ns(); t <= t1_ns; t += 50'000'000) {  // 20 Hz is ~1 m at 70 km/h
+    const Eigen::Vector3d p = traj.at(t).p_w;
+    if (!route.empty()) length_m += (p - route.back()).norm();
+    route.push_back(p);
+  }
+  return route;
+}
+
+std::vector<std::pair<std::int64_t, std::int64_t>> outagesNs(const SimRequest& r, std::int64_t t0,
+                                                             std::int64_t t1) {
+  std::vector<std::pair<std::int64_t, std::int64_t>> out;
+  const double span_s = 1e-9 * static_cast<double>(t1 - t0);
+  for (const auto& [a, b] : r.outages_s) {
+    if (!(a >= 0.0 && b > a && b <= span_s)) {
+      throw InvalidInput(fmt::format(
+          "--gnss-outage {}:{} is outside the drive (0:{:.1f} s) or empty", a, b, span_s));
+    }
+    out.emplace_back(t0 + std::llround(a * 1e9), t0 + std::llround(b * 1e9));
+  }
+  return out;
+}
+
+io::TriangleMesh worldMesh(const render::Scene& scene) {
+  io::TriangleMesh mesh;
+  for (const auto& m : scene.meshes) {
+    const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
+    mesh.vertices.insert(mesh.vertices.end(), m.vertices.begin(), m.vertices.end());
+    for (std::size_t i = 0; i + 2 < m.indices.size(); i += 3) {
+      mesh.triangles.push_back(
+          {base + m.indices[i], base + m.indices[i + 1], base + m.indices[i + 2]});
+    }
+  }
+  return mesh;
+}
+
+void writeSimYaml(const fs::path& file, const SimRequest& r, const SimConfig& c, const ImuNoise& n,
+                  const SimSummary& s) {
+  YAML::Emitter y;
+  y << YAML::BeginMap << YAML::Key << "generator" << YAML::Value << "gvio simulate";
+  y << YAML::Key << "seed" << YAML::Value << r.seed;
+  y << YAML::Key << "trajectory" << YAML::Value << r.trajectory.filename().string();
+  y << YAML::Key << "format" << YAML::Value << io::toString(r.output);
+  y << YAML::Key << "camera" << YAML::Value << (r.stereo ? "stereo" : "mono");
+  y << YAML::Key << "gnss_noise" << YAML::Value
+    << (r.gnss == GnssNoise::kNone  ? "none"
+        : r.gnss == GnssNoise::kRtk ? "rtk"
+                                    : "spp");
+  y << YAML::Key << "gnss_outages_s" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (const auto& [a, b] : r.outages_s)
+    y << YAML::Flow << YAML::BeginSeq << a << b << YAML::EndSeq;
+  y << YAML::EndSeq;
+  y << YAML::Key << "sim" << YAML::Value << YAML::BeginMap;
+  y << YAML::Key << "origin_lat_deg" << YAML::Value << c.origin_lat_deg << YAML::Key
+    << "origin_lon_deg" << YAML::Value << c.origin_lon_deg << YAML::Key << "origin_h_m"
+    << YAML::Value << c.origin_h_m;
+  y << YAML::Key << "heading_deg" << YAML::Value << c.heading_deg << YAML::Key << "camera_rate_hz"
+    << YAML::Value << c.camera_rate_hz << YAML::Key << "imu_rate_hz" << YAML::Value << c.imu_rate_hz
+    << YAML::Key << "gnss_rate_hz" << YAML::Value << c.gnss_rate_hz;
+  y << YAML::Key << "gnss_lever_arm_m" << YAML::Value << YAML::Flow << YAML::BeginSeq
+    << c.gnss_lever_arm_m.x() << c.gnss_lever_arm_m.y() << c.gnss_lever_arm_m.z() << YAML::EndSeq;
+  y << YAML::Key << "image_noise_dn" << YAML::Value << c.image_noise_dn << YAML::Key
+    << "exposure_change" << YAML::Value << c.exposure_change << YAML::Key << "exposure_amplitude"
+    << YAML::Value << c.exposure_amplitude << YAML::Key << "exposure_period_s" << YAML::Value
+    << c.exposure_period_s << YAML::Key << "motion_blur" << YAML::Value << c.motion_blur
+    << YAML::Key << "exposure_time_s" << YAML::Value << c.exposure_time_s << YAML::Key
+    << "blur_samples" << YAML::Value << c.blur_samples << YAML::Key << "knot_spacing_s"
+    << YAML::Value << c.knot_spacing_s << YAML::Key << "smoothing" << YAML::Value << c.smoothing
+    << YAML::Key << "texture_size_px" << YAML::Value << c.texture_size_px << YAML::EndMap;
+  y << YAML::Key << "imu_noise" << YAML::Value << YAML::BeginMap << YAML::Key << "acc_noise_density"
+    << YAML::Value << n.acc_noise_density << YAML::Key << "gyr_noise_density" << YAML::Value
+    << n.gyr_noise_density << YAML::Key << "acc_random_walk" << YAML::Value << n.acc_random_walk
+    << YAML::Key << "gyr_random_walk" << YAML::Value << n.gyr_random_walk << YAML::EndMap;
+  y << YAML::Key << "result" << YAML::Value << YAML::BeginMap << YAML::Key << "duration_s"
+    << YAML::Value << s.duration_s << YAML::Key << "path_length_m" << YAML::Value << s.path_length_m
+    << YAML::Key << "frames" << YAML::Value << s.frames << YAML::Key << "imu_samples" << YAML::Value
+    << s.imu_samples << YAML::Key << "gnss_fixes" << YAML::Value << s.gnss_fixes << YAML::Key
+    << "world_triangles" << YAML::Value << s.world_triangles << YAML::Key << "fit_position_rms_m"
+    << YAML::Value << s.fit.position_rms_m << YAML::Key << "fit_position_max_m" << YAML::Value
+    << s.fit.position_max_m << YAML::Key << "fit_rotation_rms_deg" << YAML::Value
+    << s.fit.rotation_rms_deg << YAML::Key << "fit_rotation_max_deg" << YAML::Value
+    << s.fit.rotation_max_deg << YAML::EndMap;
+  y << YAML::EndMap;
+  io::writeTextAtomic(file, std::string(y.c_str()) + "\n");
+}
+
+}  // namespace
+
+SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise& imu_noise,
+                    const ProgressFn& progress) {
+  config.validate();
+  if (r.output != io::DatasetFormat::kKittiRaw && r.output != io::DatasetFormat::kEuroc) {
+    throw InvalidInput("--format: the simulator writes kitti-raw or euroc");
+  }
+  if (r.seconds && !(*r.seconds > 0.0)) throw InvalidInput("--seconds must be positive");
+  const Trajectory poses = loadBodyPoses(r, config);
+  const ContinuousTrajectory traj =
+      ContinuousTrajectory::fit(poses, {config.knot_spacing_s, config.smoothing});
+  std::int64_t t1 = traj.t1_ns();
+  if (r.seconds) t1 = std::min<std::int64_t>(t1, traj.t0_ns() + std::llround(*r.seconds * 1e9));
+  const auto outages = outagesNs(r, traj.t0_ns(), t1);
+  prepareOutput(r);
+
+  SimSummary summary;
+  summary.fit = traj.report();
+  summary.duration_s = 1e-9 * static_cast<double>(t1 - traj.t0_ns());
+  spdlog::info(
+      "trajectory fit: position rms {:.3f} m (max {:.3f}), rotation rms {:.3f} deg (max {:.3f})",
+      summary.fit.position_rms_m, summary.fit.position_max_m, summary.fit.rotation_rms_deg,
+      summary.fit.rotation_max_deg);
+
+  // Truth, IMU and GNSS over [t0, t1].
+  ImuSimOptions imu_opt;
+  imu_opt.rate_hz = config.imu_rate_hz;
+  imu_opt.noise = imu_noise;
+  std::vector<ImuSimSample> imu = synthesizeImu(traj, imu_opt, mixSeed(r.seed, 1));
+  std::erase_if(imu, [&](const ImuSimSample& s) { return s.measured.t_ns > t1; });
+  const fusion::EnuFrame enu({config.origin_lat_deg, config.origin_lon_deg, config.origin_h_m});
+  GnssSimOptions gnss_opt;
+  gnss_opt.noise = r.gnss;
+  gnss_opt.rate_hz = config.gnss_rate_hz;
+  gnss_opt.lever_arm_b = config.gnss_lever_arm_m;
+  gnss_opt.outages_ns = outages;
+  const auto gnss_sim = synthesizeGnss([&](std::int64_t t) { return traj.at(t).pose(); },
+                                       traj.t0_ns(), t1, enu, gnss_opt, mixSeed(r.seed, 2));
+  std::vector<GnssFix> fixes;
+  for (const auto& g : gnss_sim) fixes.push_back(g.fix);
+  summary.imu_samples = imu.size();
+  summary.gnss_fixes = fixes.size();
+
+  // World along the route.
+  const std::vector<Eigen::Vector3d> route = routeOf(traj, t1, summary.path_length_m);
+  WorldOptions world_opt;
+  world_opt.seed = mixSeed(r.seed, 3);
+  world_opt.texture_size_px = config.texture_size_px;
+  const World world = buildWorld(route, world_opt);
+  summary.world_triangles = world.triangles;
+  fs::create_directories(r.out / "world");
+  io::writeMeshPly(r.out / "world" / "world.ply", worldMesh(world.scene));
+
+  // Calibration (KITTI chain) and the cameras' poses in the body frame, read back through the same
+  // reader the estimator uses, so images and calibration cannot disagree.
+  const render::PinholeIntrinsics K = kittiIntrinsics();
+  writeKittiCalibration(r.out, K, r.stereo);
+  std::vector<int> ids = {0};
+  if (r.stereo) ids.push_back(1);
+  std::vector<Eigen::Isometry3d> T_b_c;
+  for (const auto& cam : io::readKittiCameras(io::findKittiCalib(r.out), ids, false))
+    T_b_c.push_back(cam.T_b_c);
+
+  // Camera frames, rendered and written one at a time (memory stays flat).
+  const render::EglContext context;
+  summary.egl = context.info().platform + ": " + context.info().gl_renderer;
+  CameraSimulator cameras(context, world.scene, K, T_b_c, config, mixSeed(r.seed, 4));
+  const bool kitti = r.output == io::DatasetFormat::kKittiRaw;
+  std::vector<std::int64_t> frame_t;
+  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / config.camera_rate_hz));
+  for (std::int64_t t = traj.t0_ns(); t <= t1; t += period_ns) frame_t.push_back(t);
+  for (std::size_t k = 0; k < frame_t.size(); ++k) {
+    for (std::size_t c = 0; c < T_b_c.size(); ++c) {
+      const cv::Mat image = cameras.render(traj, frame_t[k], c, k);
+      const fs::path file =
+          kitti ? kittiImagePath(r.out, ids[c], k) : eurocImagePath(r.out, ids[c], frame_t[k]);
+      fs::create_directories(file.parent_path());
+      writeGreyPng(file, image);
+    }
+    if (progress) progress(k + 1, frame_t.size());
+  }
+  summary.frames = frame_t.size();
+
+  // Sensor logs and truth.
+  if (kitti) {
+    for (const int id : ids) writeKittiImageStamps(r.out, id, frame_t);
+    writeKittiOxts(r.out, imu, traj, enu);
+    fs::create_directories(r.out / "gnss");
+    io::writeTextAtomic(r.out / "gnss" / "fixes.nmea", toNmeaLog(fixes));
+  } else {
+    for (std::size_t c = 0; c < ids.size(); ++c)
+      writeEurocCamera(r.out, ids[c], frame_t, K, T_b_c[c], config.camera_rate_hz);
+    writeEurocImu(r.out, imu, imu_noise, config.imu_rate_hz);
+    writeEurocGnss(r.out, fixes);
+    writeEurocTruth(r.out, imu, traj);
+  }
+  Trajectory truth;
+  for (const auto& s : imu) {
+    truth.t_ns.push_back(s.measured.t_ns);
+    truth.poses.push_back(traj.at(s.measured.t_ns).pose());
+  }
+  io::writeTum(r.out / "groundtruth.tum", truth);
+  writeSimYaml(r.out / "sim.yaml", r, config, imu_noise, summary);
+  return summary;
+}
+
+}  // namespace gvio::sim

@@ -1,0 +1,46 @@
+#pragma once
+// `gvio simulate`: a drive's poses in, a complete synthetic dataset with exact truth out.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "io/dataset.hpp"
+#include "sim/gnss_synth.hpp"
+#include "sim/sim_config.hpp"
+#include "sim/trajectory_fit.hpp"
+
+namespace gvio::sim {
+
+struct SimRequest {
+  std::filesystem::path trajectory;
+  std::string trajectory_format = "auto";  // auto|tum|kitti (KITTI = odometry cam0 poses)
+  std::optional<std::filesystem::path> times;
+  io::DatasetFormat output = io::DatasetFormat::kKittiRaw;  // kitti-raw or euroc
+  std::optional<double> seconds;                            // simulate only the first S seconds
+  bool stereo = true;
+  GnssNoise gnss = GnssNoise::kSpp;
+  std::vector<std::pair<double, double>> outages_s;  // seconds since the drive's start
+  std::uint64_t seed = 1;
+  std::filesystem::path out;
+  bool force = false;
+};
+
+struct SimSummary {
+  std::size_t frames = 0, imu_samples = 0, gnss_fixes = 0, world_triangles = 0;
+  double duration_s = 0.0, path_length_m = 0.0;
+  FitReport fit;
+  std::string egl;  // EGL path and renderer used
+};
+
+using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
+
+// Throws InvalidInput/InputError for bad requests (unreadable trajectory, < 4 poses, outage
+// outside the drive, non-empty output without force, ...).
+SimSummary simulate(const SimRequest& request, const SimConfig& config, const ImuNoise& imu_noise,
+                    const ProgressFn& progress);
+
+}  // namespace gvio::sim

@@ -1,0 +1,217 @@
+// gvio simulate end to end: the output reads back through the dataset reader, is byte-identical
+// for a seed, has images a KLT front end can track, and its images, calibration, truth and
+// world.ply agree geometrically.
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <set>
+
+#include "io/dataset.hpp"
+#include "io/image_loader.hpp"
+#include "io/mesh_ply.hpp"
+#include "io/trajectory_io.hpp"
+#include "render/renderer.hpp"
+#include "support/fixtures.hpp"
+
+namespace gvio::test {
+namespace {
+using testing::HasSubstr;
+namespace fs = std::filesystem;
+
+class SimEndToEnd : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<TempDir>("sim");
+    io::writeTum(dir_->path() / "drive.tum", demoDrive());
+    const auto r =
+        runGvio(fmt::format("simulate --trajectory {} --seconds 3 --seed 7 --out {} --no-progress",
+                            (dir_->path() / "drive.tum").string(), (dir_->path() / "a").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+  static fs::path out() { return dir_->path() / "a"; }
+  static std::unique_ptr<TempDir> dir_;
+};
+std::unique_ptr<TempDir> SimEndToEnd::dir_;
+
+TEST_F(SimEndToEnd, ReadsBackAsKittiRaw) {
+  const io::Dataset ds = io::readDataset(out(), std::nullopt, {});
+  EXPECT_EQ(ds.format, io::DatasetFormat::kKittiRaw);
+  EXPECT_EQ(ds.variant, "extract");
+  ASSERT_EQ(ds.cameras.size(), 2u);
+  EXPECT_EQ(ds.cameras[0].width_px, 1241);
+  EXPECT_EQ(ds.cameras[0].height_px, 376);
+  EXPECT_NEAR(ds.cameras[0].fx, 718.856, 1e-9);
+  EXPECT_NEAR((ds.cameras[1].T_b_c.translation() - ds.cameras[0].T_b_c.translation()).norm(), 0.537,
+              1e-3);
+  EXPECT_EQ(ds.frames.size(), 31u);  // 3 s at 10 Hz, both ends
+  EXPECT_EQ(ds.imu.size(), 301u);    // 100 Hz
+  EXPECT_EQ(ds.gnss.size(), 4u);     // 1 Hz
+  ASSERT_TRUE(ds.groundtruth);
+  EXPECT_EQ(ds.groundtruth->size(), 301u);
+  EXPECT_TRUE(fs::exists(out() / "world" / "world.ply"));
+  EXPECT_TRUE(fs::exists(out() / "sim.yaml"));
+  for (const auto& f : ds.frames) {
+    for (std::size_t c = 0; c < 2; ++c)
+      EXPECT_NO_THROW(io::loadGrayImage(f.image_paths[c], ds.cameras[c]));
+  }
+}
+
+std::map<std::string, std::string> allFiles(const fs::path& root) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(root)) {
+    if (e.is_regular_file()) files[fs::relative(e.path(), root).string()] = readText(e.path());
+  }
+  return files;
+}
+
+TEST_F(SimEndToEnd, SameSeedIsByteIdentical) {
+  const std::string traj = (dir_->path() / "drive.tum").string();
+  ASSERT_EQ(
+      runGvio(fmt::format("simulate --trajectory {} --seconds 1 --seed 7 --out {} --no-progress",
+                          traj, (dir_->path() / "b").string()))
+          .exit_code,
+      0);
+  ASSERT_EQ(
+      runGvio(fmt::format("simulate --trajectory {} --seconds 1 --seed 7 --out {} --no-progress",
+                          traj, (dir_->path() / "c").string()))
+          .exit_code,
+      0);
+  ASSERT_EQ(
+      runGvio(fmt::format("simulate --trajectory {} --seconds 1 --seed 8 --out {} --no-progress",
+                          traj, (dir_->path() / "d").string()))
+          .exit_code,
+      0);
+  const auto b = allFiles(dir_->path() / "b"), c = allFiles(dir_->path() / "c"),
+             d = allFiles(dir_->path() / "d");
+  EXPECT_EQ(b.size(), c.size());
+  for (const auto& [name, bytes] : b)
+    EXPECT_TRUE(c.count(name) && c.at(name) == bytes) << name << " differs";
+  EXPECT_NE(b.at("image_00/data/0000000005.png"), d.at("image_00/data/0000000005.png"));
+}
+
+// The front-end realism bar: >= 300 Shi-Tomasi corners (quality 0.01, min distance 10)
+// per frame, and pyramidal KLT keeps >= 80 % of them to the next frame.
+TEST_F(SimEndToEnd, EveryFrameHasTrackableTexture) {
+  const io::Dataset ds = io::readDataset(out(), std::nullopt, {});
+  std::size_t min_corners = 1u << 30;
+  double min_kept = 1.0;
+  for (std::size_t k = 0; k + 1 < ds.frames.size(); ++k) {
+    const cv::Mat a = io::loadGrayImage(ds.frames[k].image_paths[0], ds.cameras[0]);
+    const cv::Mat b = io::loadGrayImage(ds.frames[k + 1].image_paths[0], ds.cameras[0]);
+    std::vector<cv::Point2f> corners, tracked;
+    cv::goodFeaturesToTrack(a, corners, 2000, 0.01, 10);
+    std::vector<std::uint8_t> status;
+    std::vector<float> err;
+    cv::calcOpticalFlowPyrLK(a, b, corners, tracked, status, err);
+    const double kept =
+        static_cast<double>(std::count(status.begin(), status.end(), 1)) / corners.size();
+    min_corners = std::min(min_corners, corners.size());
+    min_kept = std::min(min_kept, kept);
+  }
+  std::cout << "[ sim ] min corners " << min_corners << ", min KLT kept " << min_kept << "\n";
+  EXPECT_GE(min_corners, 300u);
+  EXPECT_GE(min_kept, 0.8);
+}
+
+// Corners of the left image are lifted to 3-D with depth rendered from world.ply at the true pose,
+// projected into the right camera with the written calibration, and compared with where KLT finds
+// them in the right image.
+TEST_F(SimEndToEnd, WorldPointsProjectWhereTheCalibrationSays) {
+  const io::Dataset ds = io::readDataset(out(), std::nullopt, {});
+  const io::TriangleMesh mesh = io::readMeshPly(out() / "world" / "world.ply");
+  render::Scene scene;
+  scene.textures.push_back(render::Texture{1, 1, 1, {128}});
+  render::TexturedMesh m;
+  m.vertices = mesh.vertices;
+  m.uv.assign(mesh.vertices.size(), Eigen::Vector2f::Zero());
+  for (const auto& t : mesh.triangles) m.indices.insert(m.indices.end(), t.begin(), t.end());
+  scene.meshes.push_back(std::move(m));
+  const render::EglContext context;
+  const render::Renderer renderer(context);
+  const render::GpuScene gpu(scene);
+  const auto& cam0 = ds.cameras[0];
+  const auto& cam1 = ds.cameras[1];
+  render::PinholeIntrinsics K{cam0.fx,       cam0.fy,        cam0.cx, cam0.cy,
+                              cam0.width_px, cam0.height_px, 0.3,     400.0};
+  render::Framebuffer fb(K.width, K.height);
+  std::vector<double> errors;
+  for (const std::size_t k : {5u, 15u, 25u}) {
+    const auto& frame = ds.frames[k];
+    const auto it = std::find(ds.groundtruth->t_ns.begin(), ds.groundtruth->t_ns.end(), frame.t_ns);
+    ASSERT_NE(it, ds.groundtruth->t_ns.end());
+    const Eigen::Isometry3d T_w_b =
+        ds.groundtruth->poses[static_cast<std::size_t>(it - ds.groundtruth->t_ns.begin())];
+    const render::DepthImage depth =
+        renderer.renderDepth(gpu, render::pinholeCamera(K, T_w_b * cam0.T_b_c), fb);
+    const cv::Mat left = io::loadGrayImage(frame.image_paths[0], cam0);
+    const cv::Mat right = io::loadGrayImage(frame.image_paths[1], cam1);
+    std::vector<cv::Point2f> corners, predicted, tracked;
+    cv::goodFeaturesToTrack(left, corners, 400, 0.01, 10);
+    std::vector<cv::Point2f> kept;
+    for (const auto& c : corners) {
+      const float z =
+          depth.at(static_cast<int>(std::lround(c.x)), static_cast<int>(std::lround(c.y)));
+      if (z <= 0.5F || z > 60.0F) continue;  // no surface, or too far for a meaningful disparity
+      const double zd = static_cast<double>(z);
+      const Eigen::Vector3d p_c0((static_cast<double>(c.x) - K.cx) / K.fx * zd,
+                                 (static_cast<double>(c.y) - K.cy) / K.fy * zd, zd);
+      const Eigen::Vector3d p_c1 = cam1.T_b_c.inverse() * cam0.T_b_c * p_c0;
+      kept.push_back(c);
+      predicted.emplace_back(static_cast<float>(K.fx * p_c1.x() / p_c1.z() + K.cx),
+                             static_cast<float>(K.fy * p_c1.y() / p_c1.z() + K.cy));
+    }
+    std::vector<std::uint8_t> status;
+    std::vector<float> err;
+    tracked = predicted;
+    cv::calcOpticalFlowPyrLK(
+        left, right, kept, tracked, status, err, cv::Size(21, 21), 3,
+        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 50, 0.001),
+        cv::OPTFLOW_USE_INITIAL_FLOW);
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+      if (status[i])
+        errors.push_back(std::hypot(static_cast<double>(tracked[i].x - predicted[i].x),
+                                    static_cast<double>(tracked[i].y - predicted[i].y)));
+    }
+  }
+  ASSERT_GT(errors.size(), 200u);
+  std::nth_element(errors.begin(), errors.begin() + static_cast<std::ptrdiff_t>(errors.size() / 2),
+                   errors.end());
+  const double median = errors[errors.size() / 2];
+  std::cout << "[ sim ] stereo reprojection: median " << median << " px over " << errors.size()
+            << " points\n";
+  EXPECT_LT(median, 0.5);
+}
+
+TEST_F(SimEndToEnd, BadInputIsOneLineExit2) {
+  const fs::path d = dir_->path();
+  writeText(d / "three.tum", "0 0 0 0 0 0 0 1\n0.1 1 0 0 0 0 0 1\n0.2 2 0 0 0 0 0 1\n");
+  writeText(d / "back.tum",
+            "0 0 0 0 0 0 0 1\n0.2 1 0 0 0 0 0 1\n0.1 2 0 0 0 0 0 1\n0.3 3 0 0 0 0 0 1\n");
+  const std::string traj = (d / "drive.tum").string();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"simulate --trajectory " + (d / "missing.tum").string() + " --out " + (d / "x1").string(),
+       "missing.tum"},
+      {"simulate --trajectory " + (d / "three.tum").string() + " --out " + (d / "x2").string(),
+       "at least 4"},
+      {"simulate --trajectory " + (d / "back.tum").string() + " --out " + (d / "x3").string(),
+       "not increasing"},
+      {"simulate --trajectory " + traj + " --gnss-outage 50:60 --out " + (d / "x4").string(),
+       "outside the drive"},
+      {"simulate --trajectory " + traj + " --gnss-outage 5 --out " + (d / "x5").string(), "T0:T1"},
+      {"simulate --trajectory " + traj + " --seconds 1 --out " + out().string(), "not empty"},
+  };
+  for (const auto& [args, needle] : cases) {
+    const auto r = runGvio(args + " --no-progress");
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+    EXPECT_THAT(r.err, HasSubstr(needle)) << args;
+  }
+}
+
+}  // namespace
+}  // namespace gvio::test

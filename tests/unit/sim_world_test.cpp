@@ -1,0 +1,461 @@
+// sim/world: the procedural street is deterministic, keeps the road (crossings and revisits
+// included) free, and renders images on which Shi-Tomasi corners and pyramidal KLT behave as on
+// real streets (KITTI camera; 1 m between frames, and KITTI 00's own 10 Hz frames).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <sstream>
+
+#include "odometry/error.hpp"
+#include "render/renderer.hpp"
+#include "sim/textures.hpp"
+#include "sim/world.hpp"
+
+namespace gvio::sim {
+namespace {
+
+constexpr double kBodyHeight = 0.93;    // route points are body positions above the road
+constexpr double kCameraHeight = 1.65;  // KITTI's camera above the road
+
+// A drive of legs {length m, turn rad spread over the leg}, a point every 0.5 m, on flat ground.
+std::vector<Eigen::Vector3d> drive(const std::vector<std::pair<double, double>>& legs) {
+  std::vector<Eigen::Vector3d> route{Eigen::Vector3d(0, 0, kBodyHeight)};
+  double heading = 0.0;
+  for (const auto& [length, turn] : legs) {
+    const int steps = static_cast<int>(std::lround(length / 0.5));
+    for (int k = 0; k < steps; ++k) {
+      heading += turn / steps;
+      route.push_back(route.back() +
+                      0.5 * Eigen::Vector3d(std::cos(heading), std::sin(heading), 0));
+    }
+  }
+  return route;
+}
+
+// 400 m: 150 m east, a left turn, 80 m north, a right turn, on east. Turn radius 25 m: 1 m along
+// it turns the camera 2.3 deg, about what KITTI's 10 Hz frames turn at street corners.
+std::vector<Eigen::Vector3d> twoTurns() {
+  const double q = std::numbers::pi / 2, arc = 25.0 * q;
+  return drive({{150.0, 0.0}, {arc, q}, {80.0, 0.0}, {arc, -q}, {400.0 - 230.0 - 2 * arc, 0.0}});
+}
+
+// Lemniscate of Gerono: crosses itself at right angles in the middle.
+std::vector<Eigen::Vector3d> figureEight() {
+  std::vector<Eigen::Vector3d> route;
+  const double a = 150.0;
+  for (int i = 0; i <= 1200; ++i) {
+    const double t = 2.0 * std::numbers::pi * i / 1200.0;
+    route.emplace_back(a * std::sin(t), a * std::sin(t) * std::cos(t), kBodyHeight);
+  }
+  return route;
+}
+
+// Vertices closer than `radius` (2-D) to a route point and higher than 0.2 m above the road there:
+// the highest road height (route height - body height) within radius + 1 m, since where passes
+// cross at different recorded heights the world's road lies between them. A grid of route points
+// keeps the search local.
+std::size_t verticesOnRoad(const World& world, const std::vector<Eigen::Vector3d>& route,
+                           double radius, double body_height,
+                           const std::vector<std::size_t>& skip_textures = {}) {
+  constexpr double kCell = 10.0;
+  std::map<std::pair<long, long>, std::vector<Eigen::Vector3d>> grid;
+  auto cell = [](double v) { return static_cast<long>(std::floor(v / kCell)); };
+  for (const auto& p : route) grid[{cell(p.x()), cell(p.y())}].push_back(p);
+  std::size_t bad = 0;
+  for (const auto& mesh : world.scene.meshes) {
+    if (std::find(skip_textures.begin(), skip_textures.end(), mesh.texture) != skip_textures.end())
+      continue;
+    for (const auto& v : mesh.vertices) {
+      double nearest = radius + kCell, road_z = -1e9;
+      for (long cx = cell(v.x()) - 1; cx <= cell(v.x()) + 1; ++cx) {
+        for (long cy = cell(v.y()) - 1; cy <= cell(v.y()) + 1; ++cy) {
+          const auto it = grid.find({cx, cy});
+          if (it == grid.end()) continue;
+          for (const auto& p : it->second) {
+            const double d = (p - v).head<2>().norm();
+            nearest = std::min(nearest, d);
+            if (d < radius + 1.0) road_z = std::max(road_z, p.z() - body_height);
+          }
+        }
+      }
+      if (nearest < radius && v.z() > road_z + 0.2) {
+        if (bad < 10 && std::getenv("GVIO_SIM_DEBUG") != nullptr)
+          std::cout << "    on road: texture " << mesh.texture << " at " << v.transpose() << "\n";
+        ++bad;
+      }
+    }
+  }
+  return bad;
+}
+
+using Rect = std::array<Eigen::Vector2d, 4>;
+
+// Building footprints, read back from the mesh: a building's two long walls carry its facade
+// texture and are stored one after the other; their bottom edges are two sides of the footprint.
+std::vector<Rect> buildingFootprints(const World& world, const std::vector<std::size_t>& facades) {
+  std::vector<Rect> out;
+  for (const auto& m : world.scene.meshes) {
+    if (std::find(facades.begin(), facades.end(), m.texture) == facades.end()) continue;
+    for (std::size_t i = 0; i + 7 < m.vertices.size(); i += 8) {
+      out.push_back({m.vertices[i].head<2>(), m.vertices[i + 1].head<2>(),
+                     m.vertices[i + 4].head<2>(), m.vertices[i + 5].head<2>()});
+    }
+  }
+  return out;
+}
+
+// How deep two convex quadrilaterals overlap (separating axes; 0 when apart).
+double overlapDepth(const Rect& a, const Rect& b) {
+  double depth = 1e9;
+  for (const Rect* r : {&a, &b}) {
+    for (std::size_t i = 0; i < 4; ++i) {
+      const Eigen::Vector2d e = ((*r)[(i + 1) % 4] - (*r)[i]).normalized();
+      const Eigen::Vector2d axis(-e.y(), e.x());
+      double a0 = 1e9, a1 = -1e9, b0 = 1e9, b1 = -1e9;
+      for (const auto& p : a) a0 = std::min(a0, p.dot(axis)), a1 = std::max(a1, p.dot(axis));
+      for (const auto& p : b) b0 = std::min(b0, p.dot(axis)), b1 = std::max(b1, p.dot(axis));
+      depth = std::min(depth, std::min(a1, b1) - std::max(a0, b0));
+    }
+  }
+  return std::max(depth, 0.0);
+}
+
+double deepestBuildingOverlap(const std::vector<Rect>& rects) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < rects.size(); ++i) {
+    for (std::size_t j = i + 1; j < rects.size(); ++j) {
+      if ((rects[i][0] - rects[j][0]).norm() < 120.0)  // footprints are < 45 m across
+        worst = std::max(worst, overlapDepth(rects[i], rects[j]));
+    }
+  }
+  return worst;
+}
+
+TEST(SimWorldTest, SameSeedSameWorldOtherSeedOtherWorld) {
+  const auto route = twoTurns();
+  WorldOptions o;
+  o.texture_size_px = 128;
+  const World a = buildWorld(route, o), b = buildWorld(route, o);
+  ASSERT_EQ(a.scene.meshes.size(), b.scene.meshes.size());
+  EXPECT_GT(a.triangles, 1000U);
+  for (std::size_t i = 0; i < a.scene.meshes.size(); ++i) {
+    const auto &ma = a.scene.meshes[i], &mb = b.scene.meshes[i];
+    EXPECT_EQ(ma.texture, mb.texture);
+    EXPECT_EQ(ma.indices, mb.indices);
+    ASSERT_EQ(ma.vertices.size(), mb.vertices.size());
+    EXPECT_EQ(0, std::memcmp(ma.vertices.data(), mb.vertices.data(),
+                             ma.vertices.size() * sizeof(Eigen::Vector3d)));
+    EXPECT_EQ(0, std::memcmp(ma.uv.data(), mb.uv.data(), ma.uv.size() * sizeof(Eigen::Vector2f)));
+  }
+  ASSERT_EQ(a.scene.textures.size(), b.scene.textures.size());
+  for (std::size_t i = 0; i < a.scene.textures.size(); ++i)
+    EXPECT_EQ(a.scene.textures[i].data, b.scene.textures[i].data);
+
+  o.seed = 2;
+  const World c = buildWorld(route, o);
+  EXPECT_NE(a.scene.textures[0].data, c.scene.textures[0].data);
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < std::min(a.scene.meshes.size(), c.scene.meshes.size()); ++i)
+    differing += a.scene.meshes[i].vertices != c.scene.meshes[i].vertices ? 1 : 0;
+  EXPECT_GT(differing, 0U);
+}
+
+TEST(SimWorldTest, NothingStandsOnTheRoadWhereTheRouteCrossesItself) {
+  for (const auto& route : {twoTurns(), figureEight()}) {
+    WorldOptions o;
+    o.texture_size_px = 64;
+    const World world = buildWorld(route, o);
+    EXPECT_EQ(verticesOnRoad(world, route, o.road_half_width_m, o.body_height_m), 0U);
+  }
+}
+
+// A block driven twice gets one row of buildings, not two: no building overlaps another (row
+// neighbours may touch), and the second pass only fills gaps the first one left.
+TEST(SimWorldTest, RevisitedStreetsAreNotBuiltTwice) {
+  const double q = std::numbers::pi / 2;
+  const std::vector<std::pair<double, double>> block{{200.0, 0.0}, {20.0, q},    {150.0, 0.0},
+                                                     {20.0, q},    {200.0, 0.0}, {20.0, q},
+                                                     {150.0, 0.0}, {20.0, q}};
+  std::vector<std::pair<double, double>> twice = block;
+  twice.insert(twice.end(), block.begin(), block.end());
+  WorldOptions o;
+  o.texture_size_px = 64;
+  const World once = buildWorld(drive(block), o), both = buildWorld(drive(twice), o);
+  const TextureLibrary lib = makeTextureLibrary(o.seed, 64);
+  const auto a = buildingFootprints(once, lib.facade_front);
+  const auto b = buildingFootprints(both, lib.facade_front);
+  std::cout << "[ revisit ] buildings: block driven once " << a.size() << ", twice " << b.size()
+            << "\n";
+  EXPECT_GT(a.size(), 40U);
+  EXPECT_LT(static_cast<double>(b.size()), 1.5 * static_cast<double>(a.size()));
+  EXPECT_LT(deepestBuildingOverlap(b), 0.15);
+  EXPECT_EQ(verticesOnRoad(both, drive(twice), o.road_half_width_m, o.body_height_m), 0U);
+}
+
+TEST(SimWorldTest, RejectsBadInput) {
+  WorldOptions o;
+  EXPECT_THROW(buildWorld({}, o), InvalidInput);
+  EXPECT_THROW(buildWorld({Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(1, 2, 3)}, o), InvalidInput);
+  o.texture_size_px = 300;
+  EXPECT_THROW(buildWorld(twoTurns(), o), InvalidInput);
+}
+
+TEST(SimWorldTest, TexturesHaveContrastAndAreDeterministic) {
+  const TextureLibrary a = makeTextureLibrary(7, 128), b = makeTextureLibrary(7, 128);
+  ASSERT_EQ(a.textures.size(), b.textures.size());
+  for (std::size_t i = 0; i < a.textures.size(); ++i) {
+    EXPECT_EQ(a.textures[i].data, b.textures[i].data);
+    const cv::Mat m(a.textures[i].height, a.textures[i].width, CV_8UC1,
+                    const_cast<std::uint8_t*>(a.textures[i].data.data()));
+    cv::Scalar mean, stddev;
+    cv::meanStdDev(m, mean, stddev);
+    EXPECT_GT(stddev[0], 6.0) << "texture " << i << " is nearly flat";
+  }
+  EXPECT_THROW(makeTextureLibrary(1, 100), InvalidInput);
+}
+
+// ---- Rendering: one EGL context for the suite ----
+
+render::PinholeIntrinsics kittiCamera() {
+  render::PinholeIntrinsics K;
+  K.fx = K.fy = 718.856;
+  K.cx = 607.1928;
+  K.cy = 185.2157;
+  K.width = 1241;
+  K.height = 376;
+  K.near_m = 0.3;
+  K.far_m = 1000.0;
+  return K;
+}
+
+// Camera 1.65 m above the road at arc length s, looking along the route (z forward, y down).
+Eigen::Isometry3d cameraAt(const std::vector<Eigen::Vector3d>& route, double s) {
+  auto at = [&](double arc) {
+    double acc = 0.0;
+    for (std::size_t i = 0; i + 1 < route.size(); ++i) {
+      const double len = (route[i + 1] - route[i]).head<2>().norm();
+      if (acc + len >= arc)
+        return Eigen::Vector3d(route[i] + (arc - acc) / len * (route[i + 1] - route[i]));
+      acc += len;
+    }
+    return route.back();
+  };
+  const Eigen::Vector3d p = at(s);
+  const Eigen::Vector3d t = Eigen::Vector3d(at(s + 1.0) - at(s - 1.0)).normalized();
+  Eigen::Matrix3d R;
+  R.col(2) = t;                                    // forward
+  R.col(0) = Eigen::Vector3d(t.y(), -t.x(), 0.0);  // right
+  R.col(1) = Eigen::Vector3d(0, 0, -1);            // down
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = R;
+  T.translation() = Eigen::Vector3d(p.x(), p.y(), p.z() - kBodyHeight + kCameraHeight);
+  return T;
+}
+
+cv::Mat greyOf(const render::ImageRgba& img) {  // grey textures: R = G = B
+  cv::Mat grey;
+  cv::extractChannel(
+      cv::Mat(img.height, img.width, CV_8UC4, const_cast<std::uint8_t*>(img.rgba.data())), grey, 0);
+  return grey;
+}
+
+class SimWorldRenderTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    context_ = std::make_unique<render::EglContext>();
+    renderer_ = std::make_unique<render::Renderer>(*context_);
+  }
+  static void TearDownTestSuite() {
+    renderer_.reset();
+    context_.reset();
+  }
+  cv::Mat render(const render::GpuScene& gpu, const Eigen::Isometry3d& T_w_c) const {
+    const render::PinholeIntrinsics K = kittiCamera();
+    render::Framebuffer fb(K.width, K.height);
+    return greyOf(renderer_->renderColor(gpu, render::pinholeCamera(K, T_w_c), fb));
+  }
+  // Top view of the route's surroundings with the route drawn on top.
+  void saveTopDown(const World& world, const std::vector<Eigen::Vector3d>& route,
+                   const std::string& file) const {
+    render::Scene scene = world.scene;
+    render::Polyline line;
+    for (const auto& p : route) line.points.push_back(p + Eigen::Vector3d(0, 0, 40));
+    line.colors = {render::Color(1, 0, 0, 1)};
+    scene.polylines.push_back(line);
+    Eigen::AlignedBox3d box;
+    for (const auto& p : route) box.extend(p);
+    box.min() -= Eigen::Vector3d(70, 70, 2);
+    box.max() += Eigen::Vector3d(70, 70, 45);
+    const render::GpuScene gpu(scene);
+    const int w = 1600, h = static_cast<int>(1600 * box.sizes().y() / box.sizes().x());
+    render::Framebuffer fb(w, std::clamp(h, 200, 4000));
+    const auto img = renderer_->renderColor(gpu, render::topDownCamera(box, w, fb.height()), fb);
+    cv::Mat rgba(img.height, img.width, CV_8UC4, const_cast<std::uint8_t*>(img.rgba.data())), bgr;
+    cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
+    cv::imwrite(file, bgr);
+  }
+  static std::unique_ptr<render::EglContext> context_;
+  static std::unique_ptr<render::Renderer> renderer_;
+};
+std::unique_ptr<render::EglContext> SimWorldRenderTest::context_;
+std::unique_ptr<render::Renderer> SimWorldRenderTest::renderer_;
+
+struct ViewStats {
+  int corners = 0, bottom = 0, top = 0;  // all, in the bottom third, in the top half
+  double klt_kept = 0.0;                 // fraction tracked into the next frame
+};
+
+// Shi-Tomasi corners in `a`, tracked into `b` by pyramidal KLT (OpenCV defaults: 21 x 21, 3
+// levels). With a debug name, writes `a` with kept (green) and lost (red) corners.
+ViewStats cornersAndKlt(const cv::Mat& a, const cv::Mat& b, const std::string& debug_name) {
+  std::vector<cv::Point2f> corners, next;
+  cv::goodFeaturesToTrack(a, corners, 2000, 0.01, 10);
+  ViewStats v;
+  if (corners.empty()) return v;
+  std::vector<std::uint8_t> status;
+  std::vector<float> err;
+  cv::calcOpticalFlowPyrLK(a, b, corners, next, status, err);
+  v.corners = static_cast<int>(corners.size());
+  const auto rows = static_cast<float>(a.rows);
+  for (const auto& c : corners) {
+    v.bottom += c.y > 2.0F * rows / 3.0F ? 1 : 0;
+    v.top += c.y < 0.5F * rows ? 1 : 0;
+  }
+  v.klt_kept = static_cast<double>(std::count(status.begin(), status.end(), 1)) / v.corners;
+  if (!debug_name.empty()) {
+    cv::Mat vis;
+    cv::cvtColor(a, vis, cv::COLOR_GRAY2BGR);
+    for (std::size_t k = 0; k < corners.size(); ++k)
+      cv::circle(vis, corners[k], 3, status[k] ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 0, 255));
+    cv::imwrite(debug_name, vis);
+  }
+  return v;
+}
+
+// Worst and mean over views; every view must have >= 300 corners, >= 20 of them in the bottom
+// third (road, near) and in the top half (facades, far), and KLT must keep >= 80 %.
+struct Summary {
+  ViewStats worst{1 << 30, 1 << 30, 1 << 30, 1.0};
+  double corners = 0.0, klt = 0.0;
+  int views = 0;
+
+  void add(const ViewStats& v, const std::string& label, bool print) {
+    if (print) {
+      std::cout << "  " << label << ": " << v.corners << " corners (" << v.bottom << " bottom, "
+                << v.top << " top), KLT kept " << v.klt_kept << "\n";
+    }
+    EXPECT_GE(v.corners, 300) << label;
+    EXPECT_GE(v.bottom, 20) << label;
+    EXPECT_GE(v.top, 20) << label;
+    EXPECT_GE(v.klt_kept, 0.8) << label;
+    worst = {std::min(worst.corners, v.corners), std::min(worst.bottom, v.bottom),
+             std::min(worst.top, v.top), std::min(worst.klt_kept, v.klt_kept)};
+    corners += v.corners;
+    klt += v.klt_kept;
+    ++views;
+  }
+  [[nodiscard]] std::string text() const {
+    std::ostringstream o;
+    o << views << " views: corners min " << worst.corners << " mean " << corners / views << " (min "
+      << worst.bottom << " in the bottom third, " << worst.top << " in the top half); KLT kept min "
+      << worst.klt_kept << " mean " << klt / views;
+    return o.str();
+  }
+};
+
+// 20 views along a street with two turns: enough corners everywhere in the image, and KLT keeps
+// them from one frame to the next 1 m further. GVIO_SIM_DEBUG=1 writes every view.
+TEST_F(SimWorldRenderTest, CornersAndKltAlongTheStreet) {
+  const auto route = twoTurns();
+  const World world = buildWorld(route, WorldOptions{});
+  const render::GpuScene gpu(world.scene);
+  const bool debug = std::getenv("GVIO_SIM_DEBUG") != nullptr;
+  Summary summary;
+  for (int i = 0; i < 20; ++i) {
+    const double s = 15.0 + i * 18.5;
+    const cv::Mat a = render(gpu, cameraAt(route, s)), b = render(gpu, cameraAt(route, s + 1.0));
+    if (i == 7) cv::imwrite("/tmp/sim_world_view.png", a);
+    const std::string name = debug ? "/tmp/sim_world_klt_" + std::to_string(i) + ".png" : "";
+    summary.add(cornersAndKlt(a, b, name), "view " + std::to_string(i), debug);
+  }
+  std::cout << "[ sim world ] " << world.triangles << " triangles; " << summary.text() << "\n";
+  saveTopDown(world, route, "/tmp/sim_world_topdown.png");
+}
+
+// KITTI odometry ground truth (cam0 poses; world x right, y down, z forward at the first frame)
+// as camera poses in an ENU-like frame: east = x, north = z, up = -y.
+std::vector<Eigen::Isometry3d> kittiCameraPoses(const std::filesystem::path& file) {
+  Eigen::Matrix3d M;
+  M << 1, 0, 0, 0, 0, 1, 0, -1, 0;
+  std::vector<Eigen::Isometry3d> poses;
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream ls(line);
+    Eigen::Matrix<double, 3, 4> m;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 4; ++c) ls >> m(r, c);
+    }
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = M * m.leftCols<3>();
+    T.translation() = M * m.col(3);
+    poses.push_back(T);
+  }
+  return poses;
+}
+
+// The real drive (KITTI 00, 3.7 km, crossing and revisiting its streets): triangle budget, build
+// time, a free road, and corners and KLT between consecutive ground-truth frames (10 Hz).
+TEST_F(SimWorldRenderTest, Kitti00Drive) {
+  const std::filesystem::path gt = std::string(GVIO_SHARED_DATA_DIR) + "/kitti00/KITTI_00_gt.txt";
+  if (!std::filesystem::exists(gt)) GTEST_SKIP() << gt << " not found";
+  const auto poses = kittiCameraPoses(gt);
+  ASSERT_GT(poses.size(), 4000U);
+  std::vector<Eigen::Vector3d> route;  // body positions: the camera is 1.65 m above the road
+  for (const auto& T : poses)
+    route.push_back(T.translation() - Eigen::Vector3d(0, 0, kCameraHeight - kBodyHeight));
+  const auto t0 = std::chrono::steady_clock::now();
+  const World world = buildWorld(route, WorldOptions{});
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::cout << "[ kitti 00 ] " << world.triangles << " triangles in " << world.scene.meshes.size()
+            << " meshes, built in " << seconds << " s\n";
+  EXPECT_LT(world.triangles, 1500000U);
+  // Objects only: KITTI's recorded heights differ between passes of nearby streets (up to ~1.7 m
+  // 12 m apart), so the street surfaces there follow a blended height field.
+  const TextureLibrary lib = makeTextureLibrary(WorldOptions{}.seed, 64);
+  const std::vector<std::size_t> surfaces{lib.asphalt, lib.marking, lib.paving, lib.curb,
+                                          lib.ground};
+  EXPECT_EQ(verticesOnRoad(world, route, 4.5, kBodyHeight, surfaces), 0U);
+  const auto buildings = buildingFootprints(world, lib.facade_front);
+  std::cout << "[ kitti 00 ] " << buildings.size() << " buildings\n";
+  EXPECT_LT(deepestBuildingOverlap(buildings), 0.15);
+
+  const render::GpuScene gpu(world.scene);
+  const bool debug = std::getenv("GVIO_SIM_DEBUG") != nullptr;
+  Summary summary;
+  const auto r0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < 40; ++i) {
+    const std::size_t k = 20 + static_cast<std::size_t>(i) * (poses.size() - 40) / 40;
+    const std::string name = debug ? "/tmp/sim_world_kitti_" + std::to_string(k) + ".png" : "";
+    summary.add(cornersAndKlt(render(gpu, poses[k]), render(gpu, poses[k + 1]), name),
+                "frame " + std::to_string(k), debug);
+  }
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0).count();
+  std::cout << "[ kitti 00 ] frame pairs, " << summary.text() << "; " << ms / 80.0
+            << " ms per frame incl. features (" << context_->info().gl_renderer << ")\n";
+  if (debug) saveTopDown(world, route, "/tmp/sim_world_kitti_topdown.png");
+}
+
+}  // namespace
+}  // namespace gvio::sim
