@@ -64,6 +64,24 @@ void writeKittiOxts(const fs::path& drive, const std::vector<ImuSimSample>& imu,
   writeLines(drive / "oxts" / "timestamps.txt", stamps);
 }
 
+void writeImuTruth(const fs::path& file, const std::vector<ImuSimSample>& imu) {
+  std::string csv =
+      "#timestamp [ns],f_x [m s^-2],f_y [m s^-2],f_z [m s^-2],w_x [rad s^-1],w_y [rad s^-1],w_z "
+      "[rad s^-1],"
+      "b_a_x [m s^-2],b_a_y [m s^-2],b_a_z [m s^-2],b_w_x [rad s^-1],b_w_y [rad s^-1],b_w_z [rad "
+      "s^-1]\n";
+  for (const auto& s : imu) {
+    const auto& t = s.truth;
+    csv += fmt::format(
+        "{},{:.12f},{:.12f},{:.12f},{:.12f},{:.12f},{:.12f},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:."
+        "9e}\n",
+        t.t_ns, t.acc_b_mps2.x(), t.acc_b_mps2.y(), t.acc_b_mps2.z(), t.gyr_b_radps.x(),
+        t.gyr_b_radps.y(), t.gyr_b_radps.z(), s.acc_bias.x(), s.acc_bias.y(), s.acc_bias.z(),
+        s.gyr_bias.x(), s.gyr_bias.y(), s.gyr_bias.z());
+  }
+  writeLines(file, csv);
+}
+
 fs::path kittiImagePath(const fs::path& drive, int camera, std::size_t index) {
   return drive / fmt::format("image_{:02d}", camera) / "data" / fmt::format("{:010d}.png", index);
 }

@@ -27,6 +27,9 @@ void writeKittiImageStamps(const std::filesystem::path& drive, int camera,
 std::filesystem::path kittiImagePath(const std::filesystem::path& drive, int camera,
                                      std::size_t index);
 
+// imu_truth.csv: t_ns, true specific force and rate (noise-free) and the true biases, per sample.
+void writeImuTruth(const std::filesystem::path& file, const std::vector<ImuSimSample>& imu);
+
 // EuRoC: camera folder name "cam0"/"cam1".
 std::filesystem::path eurocImagePath(const std::filesystem::path& root, int camera,
                                      std::int64_t t_ns);

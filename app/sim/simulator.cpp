@@ -35,6 +35,7 @@ const char* const kOwnedPaths[] = {"image_00",
                                    "calib_imu_to_velo.txt",
                                    "calib_velo_to_cam.txt",
                                    "groundtruth.tum",
+                                   "imu_truth.csv",
                                    "sim.yaml"};
 
 void prepareOutput(const SimRequest& r) {
@@ -250,6 +251,7 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
     writeKittiOxts(r.out, imu, traj, enu);
     fs::create_directories(r.out / "gnss");
     io::writeTextAtomic(r.out / "gnss" / "fixes.nmea", toNmeaLog(fixes));
+    io::writeTextAtomic(r.out / "gnss" / "data.csv", toGnssCsv(fixes));
   } else {
     for (std::size_t c = 0; c < ids.size(); ++c)
       writeEurocCamera(r.out, ids[c], frame_t, K, T_b_c[c], config.camera_rate_hz);
@@ -263,6 +265,7 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
     truth.poses.push_back(traj.at(s.measured.t_ns).pose());
   }
   io::writeTum(r.out / "groundtruth.tum", truth);
+  writeImuTruth(r.out / "imu_truth.csv", imu);
   writeSimYaml(r.out / "sim.yaml", r, config, imu_noise, summary);
   return summary;
 }

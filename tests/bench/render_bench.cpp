@@ -7,6 +7,7 @@
 #include <random>
 
 #include "render/renderer.hpp"
+#include "sim/kitti_convention.hpp"
 
 namespace gvio::render {
 namespace {
@@ -92,12 +93,7 @@ void BM_TexturedStreet_Kitti(benchmark::State& state) {
   UploadOptions upload;
   upload.max_anisotropy = static_cast<float>(state.range(1));
   const GpuScene gpu(street(), upload);
-  PinholeIntrinsics K;
-  K.fx = K.fy = 718.856;
-  K.cx = 607.1928;
-  K.cy = 185.2157;
-  K.width = 1241;
-  K.height = 376;
+  const PinholeIntrinsics K = sim::kittiIntrinsics();
   Eigen::Isometry3d T_w_c = Eigen::Isometry3d::Identity();
   T_w_c.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // camera z along world +x, y down
   T_w_c.translation() = Eigen::Vector3d(5, 0, 1.65);

@@ -11,6 +11,7 @@
 
 #include "render/render_error.hpp"
 #include "render/renderer.hpp"
+#include "sim/kitti_convention.hpp"
 #include "support/fixtures.hpp"
 
 namespace gvio::render {
@@ -34,15 +35,7 @@ std::unique_ptr<Renderer> RenderTest::renderer_;
 
 // KITTI's rectified camera: the simulator's.
 PinholeIntrinsics kittiCamera() {
-  PinholeIntrinsics K;
-  K.fx = K.fy = 718.856;
-  K.cx = 607.1928;
-  K.cy = 185.2157;
-  K.width = 1241;
-  K.height = 376;
-  K.near_m = 0.5;
-  K.far_m = 500.0;
-  return K;
+  return sim::kittiIntrinsics();
 }
 
 Eigen::Isometry3d someCameraPose() {

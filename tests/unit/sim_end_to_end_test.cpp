@@ -55,6 +55,10 @@ TEST_F(SimEndToEnd, ReadsBackAsKittiRaw) {
   EXPECT_EQ(ds.groundtruth->size(), 301u);
   EXPECT_TRUE(fs::exists(out() / "world" / "world.ply"));
   EXPECT_TRUE(fs::exists(out() / "sim.yaml"));
+  EXPECT_TRUE(fs::exists(out() / "gnss" / "data.csv"));
+  // True biases next to the noisy IMU: 301 samples + header.
+  const std::string truth = readText(out() / "imu_truth.csv");
+  EXPECT_EQ(std::count(truth.begin(), truth.end(), '\n'), 302);
   for (const auto& f : ds.frames) {
     for (std::size_t c = 0; c < 2; ++c)
       EXPECT_NO_THROW(io::loadGrayImage(f.image_paths[c], ds.cameras[c]));
@@ -185,6 +189,58 @@ TEST_F(SimEndToEnd, WorldPointsProjectWhereTheCalibrationSays) {
   std::cout << "[ sim ] stereo reprojection: median " << median << " px over " << errors.size()
             << " points\n";
   EXPECT_LT(median, 0.5);
+}
+
+TEST_F(SimEndToEnd, EurocMonoReadsBack) {
+  const fs::path out_dir = dir_->path() / "euroc";
+  const auto r = runGvio(fmt::format(
+      "simulate --trajectory {} --seconds 1 --format euroc --camera mono --gnss-noise rtk "
+      "--out {} --no-progress",
+      (dir_->path() / "drive.tum").string(), out_dir.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const io::Dataset ds = io::readDataset(out_dir, std::nullopt, {});
+  EXPECT_EQ(ds.format, io::DatasetFormat::kEuroc);
+  ASSERT_EQ(ds.cameras.size(), 1u);
+  EXPECT_EQ(ds.frames.size(), 11u);
+  EXPECT_EQ(ds.imu.size(), 101u);
+  EXPECT_EQ(ds.gnss.size(), 2u);
+  EXPECT_NEAR(ds.gnss.front().sigma_h_m, 0.02, 1e-9);
+  ASSERT_TRUE(ds.imu_noise);
+  ASSERT_TRUE(ds.groundtruth);
+  EXPECT_EQ(ds.groundtruth->size(), 101u);
+  EXPECT_FALSE(fs::exists(out_dir / "mav0" / "cam1"));
+}
+
+double sharpness(const cv::Mat& grey) {
+  cv::Mat lap;
+  cv::Laplacian(grey, lap, CV_64F);
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(lap, mean, stddev);
+  return stddev[0] * stddev[0];
+}
+
+// Sensor effects are opt-in config keys: motion blur lowers sharpness, exposure change brightness.
+TEST_F(SimEndToEnd, MotionBlurAndExposureChange) {
+  const std::string traj = (dir_->path() / "drive.tum").string();
+  auto run = [&](const std::string& name, const std::string& sets) {
+    const auto r = runGvio(
+        fmt::format("simulate --trajectory {} --seconds 0.6 --seed 3 --out {} --no-progress {}",
+                    traj, (dir_->path() / name).string(), sets));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return cv::imread((dir_->path() / name / "image_00" / "data" / "0000000005.png").string(),
+                      cv::IMREAD_GRAYSCALE);
+  };
+  const cv::Mat plain = run("plain", "--set sim.image_noise_dn=0");
+  const cv::Mat blurred =
+      run("blur",
+          "--set sim.image_noise_dn=0 --set sim.motion_blur=true --set sim.exposure_time_s=0.02");
+  const cv::Mat bright = run(
+      "bright",
+      "--set sim.image_noise_dn=0 --set sim.exposure_change=true --set sim.exposure_period_s=2");
+  ASSERT_FALSE(plain.empty());
+  EXPECT_LT(sharpness(blurred), 0.9 * sharpness(plain));
+  // At t = 0.5 s of a 2 s period the gain is 1 + 0.15 sin(pi / 2) = 1.15.
+  EXPECT_GT(cv::mean(bright)[0], 1.08 * cv::mean(plain)[0]);
 }
 
 TEST_F(SimEndToEnd, BadInputIsOneLineExit2) {

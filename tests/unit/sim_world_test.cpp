@@ -18,6 +18,7 @@
 
 #include "odometry/error.hpp"
 #include "render/renderer.hpp"
+#include "sim/kitti_convention.hpp"
 #include "sim/textures.hpp"
 #include "sim/world.hpp"
 
@@ -227,15 +228,7 @@ TEST(SimWorldTest, TexturesHaveContrastAndAreDeterministic) {
 // ---- Rendering: one EGL context for the suite ----
 
 render::PinholeIntrinsics kittiCamera() {
-  render::PinholeIntrinsics K;
-  K.fx = K.fy = 718.856;
-  K.cx = 607.1928;
-  K.cy = 185.2157;
-  K.width = 1241;
-  K.height = 376;
-  K.near_m = 0.3;
-  K.far_m = 1000.0;
-  return K;
+  return sim::kittiIntrinsics();
 }
 
 // Camera 1.65 m above the road at arc length s, looking along the route (z forward, y down).
