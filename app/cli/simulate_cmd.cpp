@@ -38,6 +38,7 @@ std::pair<double, double> parseOutage(const std::string& text) {
 int runSimulate(SimulateCliOptions& o, const CommonOptions& common) {
   const AppConfig config = o.config.load();
   sim::SimRequest& r = o.request;
+  r.config_yaml = dumpConfigYaml(config);
   r.trajectory = o.trajectory;
   r.out = o.out;
   if (o.times) r.times = *o.times;

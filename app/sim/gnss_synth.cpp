@@ -221,6 +221,18 @@ std::string gstBody(const GnssFix& fix, const std::string& time) {
 
 }  // namespace
 
+std::string toString(GnssNoise noise) {
+  switch (noise) {
+    case GnssNoise::kNone:
+      return "none";
+    case GnssNoise::kRtk:
+      return "rtk";
+    case GnssNoise::kSpp:
+      return "spp";
+  }
+  return "";
+}
+
 GnssNoise parseGnssNoise(const std::string& name) {
   if (name == "none") return GnssNoise::kNone;
   if (name == "rtk") return GnssNoise::kRtk;

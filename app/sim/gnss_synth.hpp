@@ -16,6 +16,7 @@ namespace gvio::sim {
 
 enum class GnssNoise { kNone, kRtk, kSpp };
 GnssNoise parseGnssNoise(const std::string& name);  // none|rtk|spp; throws InvalidInput
+std::string toString(GnssNoise noise);
 
 struct GnssSimOptions {
   GnssNoise noise = GnssNoise::kSpp;

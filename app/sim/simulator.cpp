@@ -111,53 +111,32 @@ io::TriangleMesh worldMesh(const render::Scene& scene) {
   return mesh;
 }
 
-void writeSimYaml(const fs::path& file, const SimRequest& r, const SimConfig& c, const ImuNoise& n,
-                  const SimSummary& s) {
+// Every parameter of the run: the request, the effective configuration, and what came out.
+void writeSimYaml(const fs::path& file, const SimRequest& r, const SimSummary& s) {
   YAML::Emitter y;
   y << YAML::BeginMap << YAML::Key << "generator" << YAML::Value << "gvio simulate";
   y << YAML::Key << "seed" << YAML::Value << r.seed;
   y << YAML::Key << "trajectory" << YAML::Value << r.trajectory.filename().string();
   y << YAML::Key << "format" << YAML::Value << io::toString(r.output);
   y << YAML::Key << "camera" << YAML::Value << (r.stereo ? "stereo" : "mono");
-  y << YAML::Key << "gnss_noise" << YAML::Value
-    << (r.gnss == GnssNoise::kNone  ? "none"
-        : r.gnss == GnssNoise::kRtk ? "rtk"
-                                    : "spp");
+  y << YAML::Key << "gnss_noise" << YAML::Value << toString(r.gnss);
   y << YAML::Key << "gnss_outages_s" << YAML::Value << YAML::Flow << YAML::BeginSeq;
   for (const auto& [a, b] : r.outages_s)
     y << YAML::Flow << YAML::BeginSeq << a << b << YAML::EndSeq;
   y << YAML::EndSeq;
-  y << YAML::Key << "sim" << YAML::Value << YAML::BeginMap;
-  y << YAML::Key << "origin_lat_deg" << YAML::Value << c.origin_lat_deg << YAML::Key
-    << "origin_lon_deg" << YAML::Value << c.origin_lon_deg << YAML::Key << "origin_h_m"
-    << YAML::Value << c.origin_h_m;
-  y << YAML::Key << "heading_deg" << YAML::Value << c.heading_deg << YAML::Key << "camera_rate_hz"
-    << YAML::Value << c.camera_rate_hz << YAML::Key << "imu_rate_hz" << YAML::Value << c.imu_rate_hz
-    << YAML::Key << "gnss_rate_hz" << YAML::Value << c.gnss_rate_hz;
-  y << YAML::Key << "gnss_lever_arm_m" << YAML::Value << YAML::Flow << YAML::BeginSeq
-    << c.gnss_lever_arm_m.x() << c.gnss_lever_arm_m.y() << c.gnss_lever_arm_m.z() << YAML::EndSeq;
-  y << YAML::Key << "image_noise_dn" << YAML::Value << c.image_noise_dn << YAML::Key
-    << "exposure_change" << YAML::Value << c.exposure_change << YAML::Key << "exposure_amplitude"
-    << YAML::Value << c.exposure_amplitude << YAML::Key << "exposure_period_s" << YAML::Value
-    << c.exposure_period_s << YAML::Key << "motion_blur" << YAML::Value << c.motion_blur
-    << YAML::Key << "exposure_time_s" << YAML::Value << c.exposure_time_s << YAML::Key
-    << "blur_samples" << YAML::Value << c.blur_samples << YAML::Key << "knot_spacing_s"
-    << YAML::Value << c.knot_spacing_s << YAML::Key << "smoothing" << YAML::Value << c.smoothing
-    << YAML::Key << "texture_size_px" << YAML::Value << c.texture_size_px << YAML::EndMap;
-  y << YAML::Key << "imu_noise" << YAML::Value << YAML::BeginMap << YAML::Key << "acc_noise_density"
-    << YAML::Value << n.acc_noise_density << YAML::Key << "gyr_noise_density" << YAML::Value
-    << n.gyr_noise_density << YAML::Key << "acc_random_walk" << YAML::Value << n.acc_random_walk
-    << YAML::Key << "gyr_random_walk" << YAML::Value << n.gyr_random_walk << YAML::EndMap;
-  y << YAML::Key << "result" << YAML::Value << YAML::BeginMap << YAML::Key << "duration_s"
-    << YAML::Value << s.duration_s << YAML::Key << "path_length_m" << YAML::Value << s.path_length_m
-    << YAML::Key << "frames" << YAML::Value << s.frames << YAML::Key << "imu_samples" << YAML::Value
-    << s.imu_samples << YAML::Key << "gnss_fixes" << YAML::Value << s.gnss_fixes << YAML::Key
-    << "world_triangles" << YAML::Value << s.world_triangles << YAML::Key << "fit_position_rms_m"
-    << YAML::Value << s.fit.position_rms_m << YAML::Key << "fit_position_max_m" << YAML::Value
-    << s.fit.position_max_m << YAML::Key << "fit_rotation_rms_deg" << YAML::Value
-    << s.fit.rotation_rms_deg << YAML::Key << "fit_rotation_max_deg" << YAML::Value
-    << s.fit.rotation_max_deg << YAML::EndMap;
-  y << YAML::EndMap;
+  y << YAML::Key << "config" << YAML::Value << YAML::Load(r.config_yaml);
+  y << YAML::Key << "result" << YAML::Value << YAML::BeginMap;
+  y << YAML::Key << "duration_s" << YAML::Value << s.duration_s;
+  y << YAML::Key << "path_length_m" << YAML::Value << s.path_length_m;
+  y << YAML::Key << "frames" << YAML::Value << s.frames;
+  y << YAML::Key << "imu_samples" << YAML::Value << s.imu_samples;
+  y << YAML::Key << "gnss_fixes" << YAML::Value << s.gnss_fixes;
+  y << YAML::Key << "world_triangles" << YAML::Value << s.world_triangles;
+  y << YAML::Key << "fit_position_rms_m" << YAML::Value << s.fit.position_rms_m;
+  y << YAML::Key << "fit_position_max_m" << YAML::Value << s.fit.position_max_m;
+  y << YAML::Key << "fit_rotation_rms_deg" << YAML::Value << s.fit.rotation_rms_deg;
+  y << YAML::Key << "fit_rotation_max_deg" << YAML::Value << s.fit.rotation_max_deg;
+  y << YAML::EndMap << YAML::EndMap;
   io::writeTextAtomic(file, std::string(y.c_str()) + "\n");
 }
 
@@ -266,7 +245,7 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
   }
   io::writeTum(r.out / "groundtruth.tum", truth);
   writeImuTruth(r.out / "imu_truth.csv", imu);
-  writeSimYaml(r.out / "sim.yaml", r, config, imu_noise, summary);
+  writeSimYaml(r.out / "sim.yaml", r, summary);
   return summary;
 }
 

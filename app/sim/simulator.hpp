@@ -27,6 +27,7 @@ struct SimRequest {
   std::uint64_t seed = 1;
   std::filesystem::path out;
   bool force = false;
+  std::string config_yaml;  // the effective configuration, recorded in sim.yaml
 };
 
 struct SimSummary {

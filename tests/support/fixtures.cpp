@@ -1,5 +1,7 @@
 #include "support/fixtures.hpp"
 
+#include <gtest/gtest.h>
+
 #include <fmt/format.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -7,6 +9,7 @@
 #include <atomic>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -176,6 +179,24 @@ fs::path writeKittiFixture(const fs::path& base, const KittiFixture& s) {
     writeText(drive / "groundtruth.tum", tum);
   }
   return drive;
+}
+
+fs::path cachedSimulation(const std::string& args) {
+  // The key covers the arguments and the binary, so a rebuilt simulator never serves stale data.
+  const auto stamp = fs::last_write_time(GVIO_BINARY).time_since_epoch().count();
+  const std::size_t key = std::hash<std::string>{}(args + "|" + std::to_string(stamp));
+  const fs::path cache = fs::path(GVIO_TEST_CACHE_DIR) / fmt::format("sim_{:016x}", key);
+  if (fs::exists(cache / "sim.yaml")) return cache;
+  fs::create_directories(cache.parent_path());
+  const fs::path tmp = cache.string() + fmt::format(".tmp{}", static_cast<long>(::getpid()));
+  fs::remove_all(tmp);
+  const CommandResult r =
+      runGvio(fmt::format("simulate {} --out {} --no-progress -q", args, tmp.string()));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  std::error_code ec;
+  fs::rename(tmp, cache, ec);  // loses to a concurrent process that finished first: use theirs
+  if (ec) fs::remove_all(tmp, ec);
+  return cache;
 }
 
 KittiFixture demoFixture() {

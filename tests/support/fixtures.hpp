@@ -59,6 +59,12 @@ struct CommandResult {
 };
 // Runs the built gvio binary with `args` (shell-quoted by the caller), capturing stdout/stderr.
 CommandResult runGvio(const std::string& args);
+// The output folder of `gvio simulate <args> --out <folder>`, simulated once per build of the gvio
+// binary and shared by every test process (ctest runs each test in its own process). The folder
+// is created under a temporary name and renamed into place, so concurrent tests never see a
+// half-written one. Fails the calling test when the simulation fails.
+std::filesystem::path cachedSimulation(const std::string& args);
+
 // The same with environment assignments ("NAME=value ...") in front of the command.
 CommandResult runGvioWithEnv(const std::string& env, const std::string& args);
 
