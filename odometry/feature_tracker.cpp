@@ -1,0 +1,364 @@
+#include "odometry/feature_tracker.hpp"
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <string>
+
+#include "odometry/error.hpp"
+
+namespace gvio::odometry {
+namespace {
+
+// Features this close to the image edge are dropped: their KLT window is mostly border padding,
+// and a feature about to leave the view is worth nothing to the estimator.
+constexpr float kBorderPx = 2.0F;
+// KLT stops once an iteration moves the point by less than this (VINS-Fusion's value).
+constexpr double kKltEpsilonPx = 0.01;
+// findFundamentalMat needs 8 correspondences for its RANSAC model.
+constexpr std::size_t kMinRansacPoints = 8;
+constexpr double kRansacConfidence = 0.99;
+// Absolute floor on the Shi-Tomasi response (OpenCV's scale for 8-bit images). quality_level is
+// relative to the frame's best corner, so on a featureless frame (sky, fog, a covered lens) it
+// would turn sensor noise into corners: Gaussian noise of 2 DN peaks at 1.9e-4, while the
+// weakest corners kept on textured simulated frames score about 1e-3.
+constexpr double kMinCornerResponse = 3e-4;
+// Shi-Tomasi gradient covariance over 3x3 blocks of 3x3 Sobel derivatives (goodFeaturesToTrack's
+// defaults).
+constexpr int kShiTomasiBlock = 3;
+constexpr int kShiTomasiAperture = 3;
+// The reverse KLT pass starts where a correct track must end, so it needs no coarse search: one
+// level above full resolution halves its cost (VINS-Fusion does the same), and a wrong forward
+// track whose true match lies far away cannot "come back" through the coarse levels.
+constexpr int kReverseLevels = 1;
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+void requireInt(bool ok, const char* field, int value, const char* rule) {
+  if (!ok) {
+    throw InvalidInput(std::string("config: tracker.") + field + " must be " + rule + " (got " +
+                       std::to_string(value) + ")");
+  }
+}
+
+void requirePositive(const char* field, double value) {
+  if (!std::isfinite(value) || value <= 0.0) {
+    throw InvalidInput(std::string("config: tracker.") + field +
+                       " must be a positive number (got " + std::to_string(value) + ")");
+  }
+}
+
+bool inside(const cv::Point2f& p, const cv::Size& size) {
+  return p.x >= kBorderPx && p.y >= kBorderPx &&
+         p.x <= static_cast<float>(size.width - 1) - kBorderPx &&
+         p.y <= static_cast<float>(size.height - 1) - kBorderPx;
+}
+
+// Row-major index of the grid cell (cols x rows over the image) that holds p.
+int gridCell(const cv::Point2f& p, const cv::Size& size, int cols, int rows) {
+  const int col = static_cast<int>(p.x * static_cast<float>(cols) / static_cast<float>(size.width));
+  const int row =
+      static_cast<int>(p.y * static_cast<float>(rows) / static_cast<float>(size.height));
+  return std::clamp(row, 0, rows - 1) * cols + std::clamp(col, 0, cols - 1);
+}
+
+Eigen::Vector2d toEigen(const cv::Point2f& p) {
+  return {static_cast<double>(p.x), static_cast<double>(p.y)};
+}
+
+float distance(const cv::Point2f& a, const cv::Point2f& b) {
+  return std::hypot(a.x - b.x, a.y - b.y);
+}
+
+// Keeps the elements of `v` whose flag is set, in order.
+template <typename T>
+void compact(std::vector<T>& v, const std::vector<bool>& keep) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (keep[i]) v[n++] = v[i];
+  }
+  v.resize(n);
+}
+
+// Pyramidal KLT from `from` to `to`; `to_px` holds the initial guesses when use_guess. Returns one
+// flag per point: found, and the reverse track lands within fb_threshold of where it started.
+// Both passes reuse the prebuilt pyramids (with derivatives), so nothing is recomputed.
+std::vector<bool> kltForwardBackward(const std::vector<cv::Mat>& from,
+                                     const std::vector<cv::Mat>& to,
+                                     const std::vector<cv::Point2f>& from_px,
+                                     std::vector<cv::Point2f>& to_px, bool use_guess,
+                                     const TrackerConfig& c) {
+  const cv::Size win(c.klt_window_px, c.klt_window_px);
+  const cv::TermCriteria term(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, c.klt_iterations,
+                              kKltEpsilonPx);
+  std::vector<std::uint8_t> status, back_status;
+  std::vector<float> err;
+  cv::calcOpticalFlowPyrLK(from, to, from_px, to_px, status, err, win, c.klt_levels, term,
+                           use_guess ? cv::OPTFLOW_USE_INITIAL_FLOW : 0);
+  // The reverse pass starts at the original position: a correct track comes straight back.
+  std::vector<cv::Point2f> back_px = from_px;
+  cv::calcOpticalFlowPyrLK(to, from, to_px, back_px, back_status, err, win,
+                           std::min(c.klt_levels, kReverseLevels), term,
+                           cv::OPTFLOW_USE_INITIAL_FLOW);
+  std::vector<bool> ok(from_px.size());
+  for (std::size_t i = 0; i < ok.size(); ++i) {
+    ok[i] = status[i] != 0 && back_status[i] != 0 &&
+            distance(back_px[i], from_px[i]) <= static_cast<float>(c.fb_threshold_px);
+  }
+  return ok;
+}
+
+}  // namespace
+
+void TrackerConfig::validate() const {
+  requireInt(max_features >= 1, "max_features", max_features, ">= 1");
+  if (!(quality_level > 0.0 && quality_level < 1.0)) {
+    throw InvalidInput("config: tracker.quality_level must be in (0, 1) (got " +
+                       std::to_string(quality_level) + ")");
+  }
+  requireInt(min_distance_px >= 0, "min_distance_px", min_distance_px, ">= 0");
+  requireInt(grid_cols >= 1, "grid_cols", grid_cols, ">= 1");
+  requireInt(grid_rows >= 1, "grid_rows", grid_rows, ">= 1");
+  requireInt(klt_window_px >= 3 && klt_window_px % 2 == 1, "klt_window_px", klt_window_px,
+             "odd and >= 3");
+  requireInt(klt_levels >= 0 && klt_levels <= 8, "klt_levels", klt_levels, "in [0, 8]");
+  requireInt(klt_iterations >= 1, "klt_iterations", klt_iterations, ">= 1");
+  requirePositive("fb_threshold_px", fb_threshold_px);
+  requirePositive("ransac_threshold_px", ransac_threshold_px);
+  requirePositive("stereo_max_vertical_px", stereo_max_vertical_px);
+}
+
+FeatureTracker::FeatureTracker(const TrackerConfig& config) : config_(config) {
+  config_.validate();
+}
+
+void FeatureTracker::reset() {
+  tracks_.clear();
+  has_prev_ = false;
+  image_size_ = cv::Size();
+}
+
+TrackedFrame FeatureTracker::track(std::int64_t t_ns, const cv::Mat& left, const cv::Mat& right) {
+  checkImages(left, right);
+  image_size_ = left.size();
+  TrackedFrame out;
+  out.t_ns = t_ns;
+  TrackerStats& stats = out.stats;
+
+  auto start = Clock::now();
+  buildPyramid(left, left_pyr_);
+  if (has_prev_ && !tracks_.empty()) trackPrevious(stats);
+  stats.ms_track = msSince(start);
+
+  start = Clock::now();
+  detectNew(left, stats);
+  stats.tracked = static_cast<int>(tracks_.size()) - stats.new_features;
+  stats.ms_detect = msSince(start);
+
+  start = Clock::now();
+  if (config_.stereo) {
+    buildPyramid(right, right_pyr_);
+    out.features = matchStereo(stats);
+  } else {
+    for (const Track& t : tracks_) {
+      out.features.push_back(
+          Feature{t.id, toEigen(t.px), false, Eigen::Vector2d::Zero(), t.length});
+    }
+  }
+  stats.ms_stereo = msSince(start);
+
+  std::swap(prev_pyr_, left_pyr_);  // this frame's pyramid is the next one's "previous"
+  has_prev_ = true;
+  return out;
+}
+
+void FeatureTracker::checkImages(const cv::Mat& left, const cv::Mat& right) const {
+  if (left.empty() || left.type() != CV_8UC1)
+    throw InvalidInput("feature tracker: the left image must be a non-empty 8-bit grey image");
+  if (config_.stereo && (right.empty() || right.type() != CV_8UC1))
+    throw InvalidInput("feature tracker: the right image must be a non-empty 8-bit grey image");
+  if (config_.stereo && right.size() != left.size()) {
+    throw InvalidInput("feature tracker: left and right images differ in size (" +
+                       std::to_string(left.cols) + "x" + std::to_string(left.rows) + " vs " +
+                       std::to_string(right.cols) + "x" + std::to_string(right.rows) + ")");
+  }
+  // Tracks are pixel positions: they mean nothing in an image of another size.
+  if (!image_size_.empty() && left.size() != image_size_) {
+    throw InvalidInput("feature tracker: image size changed from " +
+                       std::to_string(image_size_.width) + "x" +
+                       std::to_string(image_size_.height) + " to " + std::to_string(left.cols) +
+                       "x" + std::to_string(left.rows) + " without reset()");
+  }
+}
+
+void FeatureTracker::buildPyramid(const cv::Mat& image, std::vector<cv::Mat>& pyr) const {
+  // With derivatives, so that every KLT pass that starts from this image reuses them; never
+  // sharing the caller's pixels, because the pyramid outlives this call (next frame's "previous").
+  cv::buildOpticalFlowPyramid(image, pyr, cv::Size(config_.klt_window_px, config_.klt_window_px),
+                              config_.klt_levels, true, cv::BORDER_REFLECT_101, cv::BORDER_CONSTANT,
+                              false);
+}
+
+void FeatureTracker::trackPrevious(TrackerStats& stats) {
+  std::vector<cv::Point2f> prev_px(tracks_.size()), cur_px;
+  for (std::size_t i = 0; i < tracks_.size(); ++i) prev_px[i] = tracks_[i].px;
+  std::vector<bool> ok = kltForwardBackward(prev_pyr_, left_pyr_, prev_px, cur_px, false, config_);
+  for (std::size_t i = 0; i < ok.size(); ++i) {
+    ok[i] = ok[i] && inside(cur_px[i], image_size_);
+    tracks_[i].px = cur_px[i];
+    ++tracks_[i].length;
+  }
+  const auto before = tracks_.size();
+  compact(tracks_, ok);
+  compact(prev_px, ok);
+  stats.rejected_fb = static_cast<int>(before - tracks_.size());
+  rejectOutliersRansac(prev_px, stats);
+}
+
+// KLT follows appearance, not geometry: a track that slid along an edge or jumped to a similar
+// patch still passes the forward-backward check but breaks the epipolar constraint.
+void FeatureTracker::rejectOutliersRansac(const std::vector<cv::Point2f>& prev_px,
+                                          TrackerStats& stats) {
+  if (tracks_.size() < kMinRansacPoints) return;
+  std::vector<cv::Point2f> cur_px(tracks_.size());
+  for (std::size_t i = 0; i < tracks_.size(); ++i) cur_px[i] = tracks_[i].px;
+  std::vector<std::uint8_t> inlier;
+  const cv::Mat F = cv::findFundamentalMat(prev_px, cur_px, cv::FM_RANSAC,
+                                           config_.ransac_threshold_px, kRansacConfidence, inlier);
+  // No model (degenerate configuration): keeping the tracks is safer than dropping all of them.
+  if (F.empty() || inlier.size() != tracks_.size()) return;
+  std::vector<bool> keep(inlier.size());
+  for (std::size_t i = 0; i < keep.size(); ++i) keep[i] = inlier[i] != 0;
+  const auto before = tracks_.size();
+  compact(tracks_, keep);
+  stats.rejected_ransac = static_cast<int>(before - tracks_.size());
+}
+
+// Features that drifted within min_distance of a longer-lived one are dropped (VINS-Fusion's
+// setMask): long tracks constrain the window best, and clusters add little information. mask_
+// then keeps new corners away from the survivors.
+void FeatureTracker::thinOutAndMask(const cv::Size& size) {
+  mask_.create(size, CV_8UC1);
+  mask_.setTo(cv::Scalar(255));
+  std::vector<std::size_t> order(tracks_.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return tracks_[a].length > tracks_[b].length;
+  });
+  std::vector<bool> keep(tracks_.size(), false);
+  for (const std::size_t i : order) {
+    const cv::Point p(cvRound(tracks_[i].px.x), cvRound(tracks_[i].px.y));
+    if (mask_.at<std::uint8_t>(p) == 0) continue;
+    keep[i] = true;
+    cv::circle(mask_, p, config_.min_distance_px, cv::Scalar(0), cv::FILLED);
+  }
+  compact(tracks_, keep);
+}
+
+// The candidates of cv::goodFeaturesToTrack: 3x3 local maxima of the minimum eigenvalue inside
+// mask_, at least quality_level x the best one (and kMinCornerResponse), strongest first (ties in
+// raster order). Computed here rather than by goodFeaturesToTrack because that allocates its
+// megabyte-sized response images anew on every call, which cost more than the detection itself.
+std::vector<cv::Point2f> FeatureTracker::shiTomasiCorners(const cv::Mat& image) {
+  cv::cornerMinEigenVal(image, response_, kShiTomasiBlock, kShiTomasiAperture);
+  double best = 0.0;
+  cv::minMaxLoc(response_, nullptr, &best, nullptr, nullptr, mask_);
+  const auto threshold =
+      static_cast<float>(std::max(config_.quality_level * best, kMinCornerResponse));
+  cv::dilate(response_, local_max_, cv::Mat());
+  std::vector<std::pair<float, int>> candidates;  // response, raster index
+  for (int y = 1; y + 1 < image.rows; ++y) {
+    const auto* r = response_.ptr<float>(y);
+    const auto* m = local_max_.ptr<float>(y);
+    const auto* allowed = mask_.ptr<std::uint8_t>(y);
+    for (int x = 1; x + 1 < image.cols; ++x) {
+      if (r[x] >= threshold && r[x] == m[x] && allowed[x] != 0)
+        candidates.emplace_back(r[x], y * image.cols + x);
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second < b.second;
+  });
+  std::vector<cv::Point2f> corners(candidates.size());
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const int index = candidates[i].second;
+    corners[i] =
+        cv::Point2f(static_cast<float>(index % image.cols), static_cast<float>(index / image.cols));
+  }
+  return corners;
+}
+
+// New corners, strongest first, where mask_ allows and their grid cell holds fewer than
+// ceil(max_features / cells) features; each one accepted blocks min_distance around itself.
+void FeatureTracker::detectNew(const cv::Mat& left, TrackerStats& stats) {
+  thinOutAndMask(left.size());
+  const int need = config_.max_features - static_cast<int>(tracks_.size());
+  if (need <= 0) return;
+  const int cells = config_.grid_cols * config_.grid_rows;
+  const int cap = (config_.max_features + cells - 1) / cells;
+  auto cellOf = [&](const cv::Point2f& p) {
+    return static_cast<std::size_t>(gridCell(p, left.size(), config_.grid_cols, config_.grid_rows));
+  };
+  std::vector<int> count(static_cast<std::size_t>(cells), 0);
+  for (const Track& t : tracks_) ++count[cellOf(t.px)];
+  int added = 0;
+  for (const cv::Point2f& p : shiTomasiCorners(left)) {
+    if (added == need) break;
+    int& n = count[cellOf(p)];
+    const cv::Point pixel(cvRound(p.x), cvRound(p.y));
+    if (n >= cap || !inside(p, left.size()) || mask_.at<std::uint8_t>(pixel) == 0) continue;
+    cv::circle(mask_, pixel, config_.min_distance_px, cv::Scalar(0), cv::FILLED);
+    ++n;
+    ++added;
+    Track t;
+    t.id = next_id_++;
+    t.px = p;
+    tracks_.push_back(t);
+  }
+  stats.new_features = added;
+}
+
+// Rectified stereo: the match lies on the same row, left of the left position. KLT starts from
+// the previous frame's disparity when the feature had one (close points sit far beyond the
+// pyramid's reach from a zero guess), else from the same position.
+std::vector<Feature> FeatureTracker::matchStereo(TrackerStats& stats) {
+  std::vector<Feature> features;
+  features.reserve(tracks_.size());
+  if (tracks_.empty()) return features;
+  std::vector<cv::Point2f> left_px(tracks_.size()), right_px(tracks_.size());
+  for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    left_px[i] = tracks_[i].px;
+    right_px[i] = left_px[i] - cv::Point2f(tracks_[i].has_disparity ? tracks_[i].disparity : 0, 0);
+  }
+  const std::vector<bool> ok =
+      kltForwardBackward(left_pyr_, right_pyr_, left_px, right_px, true, config_);
+  for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    Track& t = tracks_[i];
+    const cv::Point2f& l = left_px[i];
+    const cv::Point2f& r = right_px[i];
+    const bool match = ok[i] && inside(r, image_size_) &&
+                       std::abs(r.y - l.y) <= static_cast<float>(config_.stereo_max_vertical_px) &&
+                       r.x <= l.x;
+    t.has_disparity = match;
+    t.disparity = match ? l.x - r.x : 0.0F;
+    if (match) {
+      ++stats.stereo_matches;
+    } else {
+      ++stats.rejected_stereo;
+    }
+    features.push_back(Feature{t.id, toEigen(l), match,
+                               match ? toEigen(r) : Eigen::Vector2d::Zero().eval(), t.length});
+  }
+  return features;
+}
+
+}  // namespace gvio::odometry

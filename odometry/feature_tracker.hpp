@@ -1,0 +1,108 @@
+#pragma once
+// Visual front end (VINS-Fusion / OpenVINS style): Shi-Tomasi corners on the left image, tracked
+// frame to frame with pyramidal KLT, cleaned by a forward-backward check and a fundamental-matrix
+// RANSAC, topped up over a grid, and matched into the right image of a rectified stereo pair.
+// Pure image processing: no camera model, no file I/O, no state beyond the previous frame.
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace gvio::odometry {
+
+struct TrackerConfig {
+  int max_features = 200;       // per left image
+  double quality_level = 0.01;  // Shi-Tomasi: corners weaker than this x the strongest are dropped
+  int min_distance_px = 20;     // minimum distance between features (old and new)
+  // New detections are spread over a grid, at most ceil(max_features / cells) per cell, so that
+  // one highly textured facade does not take every feature (poorly conditioned geometry).
+  int grid_cols = 8, grid_rows = 4;
+  int klt_window_px = 21;  // odd side of the KLT window
+  int klt_levels = 3;      // pyramid levels above the full-resolution image
+  int klt_iterations = 30;
+  double fb_threshold_px = 1.0;         // forward-backward check: max round-trip miss
+  double ransac_threshold_px = 1.0;     // fundamental-matrix RANSAC between consecutive left frames
+  double stereo_max_vertical_px = 2.0;  // rectified stereo: reject matches off the epipolar line
+  bool stereo = true;
+
+  void validate() const;  // throws InvalidInput naming the field
+};
+
+struct Feature {
+  std::uint64_t id = 0;  // unique over the tracker's life, kept while the feature is tracked
+  Eigen::Vector2d px_left = Eigen::Vector2d::Zero();
+  bool has_right = false;
+  Eigen::Vector2d px_right = Eigen::Vector2d::Zero();  // valid when has_right
+  int track_length = 1;  // frames this id has been seen in, this one included
+};
+
+struct TrackerStats {
+  // Features carried over from the previous frame (after dropping those that drifted next to a
+  // longer-lived feature).
+  int tracked = 0;
+  int new_features = 0;  // fresh detections in this frame
+  int rejected_fb = 0;   // lost by KLT, the border or the forward-backward check
+  int rejected_ransac = 0;
+  int stereo_matches = 0;
+  int rejected_stereo = 0;  // stereo KLT failures, forward-backward, epipolar or disparity sign
+  // Informational wall-clock timings of the three stages (not asserted anywhere).
+  double ms_detect = 0, ms_track = 0, ms_stereo = 0;
+};
+
+struct TrackedFrame {
+  std::int64_t t_ns = 0;
+  std::vector<Feature> features;
+  TrackerStats stats;
+};
+
+class FeatureTracker {
+ public:
+  explicit FeatureTracker(const TrackerConfig& config);
+  // Not copyable: the image buffers below would be shared between the copies.
+  FeatureTracker(const FeatureTracker&) = delete;
+  FeatureTracker& operator=(const FeatureTracker&) = delete;
+  FeatureTracker(FeatureTracker&&) = default;
+  FeatureTracker& operator=(FeatureTracker&&) = default;
+
+  // `left` (and `right` when config.stereo) are 8-bit grey images of equal size, the same size
+  // on every call until reset(); throws InvalidInput otherwise. Black or textureless images give
+  // zero features.
+  TrackedFrame track(std::int64_t t_ns, const cv::Mat& left, const cv::Mat& right = cv::Mat());
+
+  // Forgets every track (e.g. after a black frame or a camera dropout); ids keep increasing so
+  // that a consumer never confuses a new feature with an old one.
+  void reset();
+
+ private:
+  // Per-feature state carried from one frame to the next (parallel to the output features).
+  struct Track {
+    std::uint64_t id = 0;
+    cv::Point2f px;
+    int length = 1;
+    bool has_disparity = false;
+    float disparity = 0.0F;  // left x - right x in the frame it was measured, a stereo KLT guess
+  };
+
+  void checkImages(const cv::Mat& left, const cv::Mat& right) const;
+  void buildPyramid(const cv::Mat& image, std::vector<cv::Mat>& pyr) const;
+  void trackPrevious(TrackerStats& stats);
+  void rejectOutliersRansac(const std::vector<cv::Point2f>& prev_px, TrackerStats& stats);
+  void thinOutAndMask(const cv::Size& size);
+  std::vector<cv::Point2f> shiTomasiCorners(const cv::Mat& image);
+  void detectNew(const cv::Mat& left, TrackerStats& stats);
+  std::vector<Feature> matchStereo(TrackerStats& stats);
+
+  TrackerConfig config_;
+  std::uint64_t next_id_ = 0;
+  std::vector<Track> tracks_;  // features of the previous (then current) left image
+  bool has_prev_ = false;      // prev_pyr_ holds the previous left image (false after reset())
+  cv::Size image_size_;
+  // Image buffers kept from frame to frame only so that OpenCV reuses their memory: fresh
+  // megabyte-sized allocations each frame cost more in page faults than the arithmetic on them.
+  std::vector<cv::Mat> prev_pyr_, left_pyr_, right_pyr_;  // KLT pyramids with derivatives
+  cv::Mat mask_;                                          // where new corners may go
+  cv::Mat response_, local_max_;                          // Shi-Tomasi response, its 3x3 maximum
+};
+
+}  // namespace gvio::odometry

@@ -1,0 +1,392 @@
+// The visual front end on a simulated KITTI-like drive: tracks persist and agree with the true
+// camera motion, stereo matches lie on the epipolar line, corrupted and black frames are handled,
+// bad configurations and images are refused, and the output is deterministic.
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <numeric>
+#include <set>
+
+#include "io/dataset.hpp"
+#include "io/image_loader.hpp"
+#include "io/trajectory_io.hpp"
+#include "odometry/error.hpp"
+#include "odometry/feature_tracker.hpp"
+#include "support/fixtures.hpp"
+
+namespace gvio::test {
+namespace {
+using odometry::Feature;
+using odometry::FeatureTracker;
+using odometry::TrackedFrame;
+using odometry::TrackerConfig;
+using testing::HasSubstr;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+std::map<std::uint64_t, Feature> byId(const TrackedFrame& frame) {
+  std::map<std::uint64_t, Feature> m;
+  for (const Feature& f : frame.features) m[f.id] = f;
+  return m;
+}
+
+class FeatureTrackerTest : public ::testing::Test {
+ protected:
+  // One 3 s simulated drive (31 stereo frames) and the default tracker's output on it.
+  static void SetUpTestSuite() {
+    const std::filesystem::path drive = cachedSimulation(fmt::format(
+        "--trajectory {}/assets/demo/drive.tum --seconds 3 --seed 11", GVIO_SOURCE_DIR));
+    dataset_ =
+        std::make_unique<io::Dataset>(io::readDataset(drive, std::nullopt, io::ReaderConfig{}));
+    ASSERT_EQ(dataset_->cameras.size(), 2u);
+    ASSERT_EQ(dataset_->frames.size(), 31u);
+    for (const auto& f : dataset_->frames) {
+      left_.push_back(io::loadGrayImage(f.image_paths[0], dataset_->cameras[0]));
+      right_.push_back(io::loadGrayImage(f.image_paths[1], dataset_->cameras[1]));
+    }
+    FeatureTracker tracker{TrackerConfig{}};
+    for (std::size_t k = 0; k < left_.size(); ++k)
+      tracked_.push_back(tracker.track(dataset_->frames[k].t_ns, left_[k], right_[k]));
+  }
+  void SetUp() override {
+    ASSERT_TRUE(dataset_) << "the simulation failed";
+    ASSERT_EQ(tracked_.size(), 31u);
+  }
+  static void TearDownTestSuite() {
+    tracked_.clear();
+    left_.clear();
+    right_.clear();
+    dataset_.reset();
+  }
+
+  // True camera-to-world pose of the left camera at frame k.
+  static Eigen::Isometry3d cameraPose(std::size_t k) {
+    const Trajectory& gt = *dataset_->groundtruth;
+    const auto it = std::find(gt.t_ns.begin(), gt.t_ns.end(), dataset_->frames[k].t_ns);
+    // at(): a frame without a truth pose fails the test instead of reading past the end.
+    return gt.poses.at(static_cast<std::size_t>(it - gt.t_ns.begin())) * dataset_->cameras[0].T_b_c;
+  }
+
+  static std::unique_ptr<io::Dataset> dataset_;
+  static std::vector<cv::Mat> left_, right_;
+  static std::vector<TrackedFrame> tracked_;
+};
+std::unique_ptr<io::Dataset> FeatureTrackerTest::dataset_;
+std::vector<cv::Mat> FeatureTrackerTest::left_, FeatureTrackerTest::right_;
+std::vector<TrackedFrame> FeatureTrackerTest::tracked_;
+
+TEST_F(FeatureTrackerTest, TracksPersistWithUniqueIds) {
+  ASSERT_EQ(tracked_.size(), 31u);
+  std::vector<double> median_length, mean_length;
+  int min_features = 1 << 30, min_tracked = 1 << 30;
+  double sum_new = 0, sum_fb = 0, sum_ransac = 0;
+  for (std::size_t k = 0; k < tracked_.size(); ++k) {
+    const TrackedFrame& f = tracked_[k];
+    EXPECT_EQ(f.t_ns, dataset_->frames[k].t_ns);
+    EXPECT_LE(f.features.size(), 200u);
+    EXPECT_EQ(f.stats.tracked + f.stats.new_features, static_cast<int>(f.features.size()));
+    std::set<std::uint64_t> ids;
+    std::vector<double> lengths;
+    for (const Feature& feat : f.features) {
+      EXPECT_TRUE(ids.insert(feat.id).second) << "duplicate id " << feat.id << " in frame " << k;
+      lengths.push_back(feat.track_length);
+    }
+    median_length.push_back(median(lengths));
+    mean_length.push_back(std::accumulate(lengths.begin(), lengths.end(), 0.0) /
+                          static_cast<double>(std::max<std::size_t>(lengths.size(), 1)));
+    if (k == 0) {
+      EXPECT_EQ(f.stats.tracked, 0);
+      continue;
+    }
+    min_features = std::min(min_features, static_cast<int>(f.features.size()));
+    min_tracked = std::min(min_tracked, f.stats.tracked);
+    sum_new += f.stats.new_features;
+    sum_fb += f.stats.rejected_fb;
+    sum_ransac += f.stats.rejected_ransac;
+    // A feature seen before was in the previous frame under the same id, one frame shorter.
+    const auto prev = byId(tracked_[k - 1]);
+    int carried = 0;
+    for (const Feature& feat : f.features) {
+      if (feat.track_length == 1) {
+        EXPECT_EQ(prev.count(feat.id), 0u) << "new feature reuses id " << feat.id;
+        continue;
+      }
+      ++carried;
+      const auto it = prev.find(feat.id);
+      ASSERT_NE(it, prev.end()) << "id " << feat.id << " in frame " << k << " came from nowhere";
+      EXPECT_EQ(feat.track_length, it->second.track_length + 1);
+    }
+    EXPECT_EQ(carried, f.stats.tracked);
+  }
+  std::cout << "[ tracker ] min features/frame " << min_features << ", median track length at "
+            << "frames 1/5/10/20/30: " << median_length[1] << "/" << median_length[5] << "/"
+            << median_length[10] << "/" << median_length[20] << "/" << median_length[30]
+            << " (mean " << mean_length[5] << " at 5, " << mean_length[30]
+            << " at 30); per frame: min tracked " << min_tracked << ", mean new " << sum_new / 30
+            << ", rejected fb " << sum_fb / 30 << ", ransac " << sum_ransac / 30 << "\n";
+  EXPECT_GE(min_features, 150);
+  // Ids persist: past the start the typical feature has lived for several frames, and the
+  // population keeps ageing (features near the focus of expansion live for the whole drive).
+  for (std::size_t k = 5; k < median_length.size(); ++k) EXPECT_GE(median_length[k], 4.0) << k;
+  EXPECT_GT(mean_length[30], mean_length[5] + 1.0);
+}
+
+TEST_F(FeatureTrackerTest, StereoMatchesLieOnTheEpipolarLine) {
+  std::vector<double> vertical;
+  double min_fraction = 1.0;
+  for (const TrackedFrame& f : tracked_) {
+    int matched = 0;
+    for (const Feature& feat : f.features) {
+      if (!feat.has_right) continue;
+      ++matched;
+      vertical.push_back(std::abs(feat.px_right.y() - feat.px_left.y()));
+      EXPECT_LE(feat.px_right.x(), feat.px_left.x());  // non-negative disparity
+    }
+    EXPECT_EQ(matched, f.stats.stereo_matches);
+    EXPECT_EQ(f.stats.stereo_matches + f.stats.rejected_stereo,
+              static_cast<int>(f.features.size()));
+    min_fraction = std::min(min_fraction,
+                            static_cast<double>(matched) / static_cast<double>(f.features.size()));
+  }
+  std::cout << "[ tracker ] stereo: min matched fraction " << min_fraction << ", median |dy| "
+            << median(vertical) << " px\n";
+  EXPECT_GE(min_fraction, 0.6);
+  EXPECT_LT(median(vertical), 0.3);
+}
+
+// Stereo features of frame k are lifted to 3-D with the true baseline, moved with the true camera
+// motion to frame k + 1 and projected: they must land where the tracker followed them.
+TEST_F(FeatureTrackerTest, TracksAgreeWithTheTrueMotion) {
+  const CameraModel& cam = dataset_->cameras[0];
+  const double baseline =
+      (dataset_->cameras[1].T_b_c.translation() - cam.T_b_c.translation()).norm();
+  std::vector<double> errors;
+  for (std::size_t k = 0; k + 1 < tracked_.size(); ++k) {
+    const Eigen::Isometry3d T_next_cur = cameraPose(k + 1).inverse() * cameraPose(k);
+    const auto next = byId(tracked_[k + 1]);
+    for (const Feature& f : tracked_[k].features) {
+      const auto it = next.find(f.id);
+      const double disparity = f.px_left.x() - f.px_right.x();
+      // Below 2 px the depth (and with it the prediction) is too uncertain to judge the track.
+      if (!f.has_right || disparity < 2.0 || it == next.end()) continue;
+      const double z = cam.fx * baseline / disparity;
+      const Eigen::Vector3d p_cur((f.px_left.x() - cam.cx) / cam.fx * z,
+                                  (f.px_left.y() - cam.cy) / cam.fy * z, z);
+      const Eigen::Vector3d p = T_next_cur * p_cur;
+      const Eigen::Vector2d predicted(cam.fx * p.x() / p.z() + cam.cx,
+                                      cam.fy * p.y() / p.z() + cam.cy);
+      errors.push_back((predicted - it->second.px_left).norm());
+    }
+  }
+  ASSERT_GT(errors.size(), 1000u);
+  std::vector<double> sorted = errors;
+  std::sort(sorted.begin(), sorted.end());
+  const double p90 = sorted[sorted.size() * 9 / 10];
+  std::cout << "[ tracker ] true-motion reprojection: median " << median(errors) << " px, p90 "
+            << p90 << " px over " << errors.size() << " tracks\n";
+  EXPECT_LT(median(errors), 0.5);
+  EXPECT_LT(p90, 2.0);
+}
+
+// Frame k + 1 with a 200 x 150 region (around the focus of expansion) replaced by the content 40 px
+// right and 40 px down: the tracks that started in the region must be rejected, the others must
+// survive as on the clean frame. KLT may well find the displaced content (the forward-backward
+// check then passes), so rejection rests on the epipolar constraint, which cannot see an error
+// along the epipolar line: a few tracks next to the focus of expansion, where every direction is
+// nearly along it, may survive. (A horizontal shift would be a poor probe for the same reason:
+// the epipolar lines there are nearly horizontal.)
+TEST_F(FeatureTrackerTest, RejectsTracksIntoAPastedPatch) {
+  constexpr std::size_t k = 10;
+  const cv::Rect region(500, 150, 200, 150);
+  cv::Mat corrupted = left_[k + 1].clone();
+  left_[k + 1](region + cv::Point(40, 40)).copyTo(corrupted(region));
+
+  FeatureTracker clean{TrackerConfig{}}, dirty{TrackerConfig{}};
+  TrackedFrame before;
+  for (std::size_t i = 0; i <= k; ++i) {
+    before = clean.track(dataset_->frames[i].t_ns, left_[i], right_[i]);
+    dirty.track(dataset_->frames[i].t_ns, left_[i], right_[i]);
+  }
+  const std::int64_t t = dataset_->frames[k + 1].t_ns;
+  const TrackedFrame a = clean.track(t, left_[k + 1], right_[k + 1]);
+  const TrackedFrame b = dirty.track(t, corrupted, right_[k + 1]);
+  const auto a_ids = byId(a), b_ids = byId(b);
+
+  const cv::Rect inner(region.x + 12, region.y + 12, region.width - 24, region.height - 24);
+  const cv::Rect outer(region.x - 60, region.y - 30, region.width + 120, region.height + 60);
+  int in_region = 0, in_region_kept = 0, outside_clean = 0, outside_kept = 0, wrong = 0;
+  for (const Feature& f : before.features) {
+    const cv::Point2f p(static_cast<float>(f.px_left.x()), static_cast<float>(f.px_left.y()));
+    const auto ib = b_ids.find(f.id);
+    const auto ia = a_ids.find(f.id);
+    const bool kept = ib != b_ids.end() && ib->second.track_length > 1;
+    if (kept && ia != a_ids.end() && (ib->second.px_left - ia->second.px_left).norm() > 1.0)
+      ++wrong;
+    if (inner.contains(p)) {
+      ++in_region;
+      in_region_kept += kept ? 1 : 0;
+    } else if (!outer.contains(p) && ia != a_ids.end() && ia->second.track_length > 1) {
+      ++outside_clean;
+      outside_kept += kept ? 1 : 0;
+    }
+  }
+  std::cout << "[ tracker ] pasted patch: " << in_region_kept << "/" << in_region
+            << " tracks kept inside, " << outside_kept << "/" << outside_clean
+            << " outside; rejected fb " << b.stats.rejected_fb << " (clean " << a.stats.rejected_fb
+            << "), ransac " << b.stats.rejected_ransac << " (clean " << a.stats.rejected_ransac
+            << "); " << wrong << " surviving tracks differ from the clean ones\n";
+  ASSERT_GE(in_region, 5);
+  EXPECT_GT(b.stats.rejected_fb + b.stats.rejected_ransac,
+            a.stats.rejected_fb + a.stats.rejected_ransac);
+  EXPECT_LE(in_region_kept, in_region / 5);
+  EXPECT_LE(wrong, in_region / 5);
+  EXPECT_GE(outside_kept, outside_clean * 9 / 10);
+}
+
+TEST_F(FeatureTrackerTest, BlackFrameGivesNoFeaturesAndResetRecovers) {
+  FeatureTracker tracker{TrackerConfig{}};
+  std::uint64_t max_id = 0;
+  for (std::size_t k = 0; k < 5; ++k) {
+    for (const Feature& f : tracker.track(dataset_->frames[k].t_ns, left_[k], right_[k]).features)
+      max_id = std::max(max_id, f.id);
+  }
+  const cv::Mat black = cv::Mat::zeros(left_[0].size(), CV_8UC1);
+  TrackedFrame dark;
+  ASSERT_NO_THROW(dark = tracker.track(dataset_->frames[5].t_ns, black, black));
+  EXPECT_TRUE(dark.features.empty());
+  EXPECT_EQ(dark.stats.tracked, 0);
+  EXPECT_EQ(dark.stats.new_features, 0);
+  // Then a featureless grey frame with the simulator's sensor noise (2 DN): noise is no corner.
+  cv::Mat grey(left_[0].size(), CV_8UC1);
+  cv::RNG rng(5);
+  rng.fill(grey, cv::RNG::NORMAL, 128, 2);
+  EXPECT_TRUE(tracker.track(dataset_->frames[6].t_ns, grey, grey).features.empty());
+
+  tracker.reset();
+  const TrackedFrame back = tracker.track(dataset_->frames[7].t_ns, left_[7], right_[7]);
+  EXPECT_GE(back.features.size(), 150u);
+  for (const Feature& f : back.features) {
+    EXPECT_GT(f.id, max_id);  // ids keep increasing over a reset
+    EXPECT_EQ(f.track_length, 1);
+  }
+  const TrackedFrame next = tracker.track(dataset_->frames[8].t_ns, left_[8], right_[8]);
+  EXPECT_GE(next.stats.tracked, 120);
+}
+
+TEST_F(FeatureTrackerTest, MonoTracksWithoutRightImage) {
+  TrackerConfig config;
+  config.stereo = false;
+  FeatureTracker tracker(config);
+  TrackedFrame f;
+  for (std::size_t k = 0; k < 4; ++k) f = tracker.track(dataset_->frames[k].t_ns, left_[k]);
+  EXPECT_GE(f.stats.tracked, 120);
+  EXPECT_EQ(f.stats.stereo_matches, 0);
+  for (const Feature& feat : f.features) EXPECT_FALSE(feat.has_right);
+}
+
+TEST_F(FeatureTrackerTest, SameFramesSameOutput) {
+  FeatureTracker a{TrackerConfig{}}, b{TrackerConfig{}};
+  for (std::size_t k = 0; k < 12; ++k) {
+    const TrackedFrame fa = a.track(dataset_->frames[k].t_ns, left_[k], right_[k]);
+    const TrackedFrame fb = b.track(dataset_->frames[k].t_ns, left_[k], right_[k]);
+    ASSERT_EQ(fa.features.size(), fb.features.size()) << "frame " << k;
+    for (std::size_t i = 0; i < fa.features.size(); ++i) {
+      const Feature &x = fa.features[i], &y = fb.features[i];
+      EXPECT_EQ(x.id, y.id);
+      EXPECT_EQ(x.px_left, y.px_left);
+      EXPECT_EQ(x.has_right, y.has_right);
+      EXPECT_EQ(x.px_right, y.px_right);
+      EXPECT_EQ(x.track_length, y.track_length);
+    }
+    EXPECT_EQ(fa.stats.rejected_fb, fb.stats.rejected_fb);
+    EXPECT_EQ(fa.stats.rejected_ransac, fb.stats.rejected_ransac);
+    EXPECT_EQ(fa.stats.rejected_stereo, fb.stats.rejected_stereo);
+  }
+}
+
+std::string invalidInput(const std::function<void()>& fn) {
+  try {
+    fn();
+  } catch (const InvalidInput& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected InvalidInput";
+  return {};
+}
+
+TEST(FeatureTrackerConfig, BadValuesNameTheField) {
+  EXPECT_NO_THROW(TrackerConfig{}.validate());
+  const std::vector<std::pair<std::string, std::function<void(TrackerConfig&)>>> cases = {
+      {"max_features", [](TrackerConfig& c) { c.max_features = 0; }},
+      {"quality_level", [](TrackerConfig& c) { c.quality_level = 0.0; }},
+      {"quality_level", [](TrackerConfig& c) { c.quality_level = 1.5; }},
+      {"min_distance_px", [](TrackerConfig& c) { c.min_distance_px = -1; }},
+      {"grid_cols", [](TrackerConfig& c) { c.grid_cols = 0; }},
+      {"grid_rows", [](TrackerConfig& c) { c.grid_rows = -2; }},
+      {"klt_window_px", [](TrackerConfig& c) { c.klt_window_px = 20; }},
+      {"klt_window_px", [](TrackerConfig& c) { c.klt_window_px = 1; }},
+      {"klt_levels", [](TrackerConfig& c) { c.klt_levels = -1; }},
+      {"klt_iterations", [](TrackerConfig& c) { c.klt_iterations = 0; }},
+      {"fb_threshold_px", [](TrackerConfig& c) { c.fb_threshold_px = 0.0; }},
+      {"ransac_threshold_px",
+       [](TrackerConfig& c) { c.ransac_threshold_px = std::numeric_limits<double>::quiet_NaN(); }},
+      {"stereo_max_vertical_px", [](TrackerConfig& c) { c.stereo_max_vertical_px = -1.0; }},
+  };
+  for (const auto& [field, spoil] : cases) {
+    TrackerConfig c;
+    spoil(c);
+    EXPECT_THAT(invalidInput([&] { c.validate(); }), HasSubstr(field));
+    EXPECT_THAT(invalidInput([&] { FeatureTracker{c}; }), HasSubstr(field));
+  }
+}
+
+TEST(FeatureTrackerImages, MismatchedImagesThrow) {
+  FeatureTracker tracker{TrackerConfig{}};
+  const cv::Mat a(120, 160, CV_8UC1, cv::Scalar(0)), b(100, 160, CV_8UC1, cv::Scalar(0));
+  const cv::Mat colour(120, 160, CV_8UC3, cv::Scalar(0, 0, 0));
+  EXPECT_THAT(invalidInput([&] { tracker.track(0, a, b); }), HasSubstr("differ in size"));
+  EXPECT_THAT(invalidInput([&] { tracker.track(0, a); }), HasSubstr("right image"));
+  EXPECT_THAT(invalidInput([&] { tracker.track(0, colour, colour); }), HasSubstr("left image"));
+  EXPECT_THAT(invalidInput([&] { tracker.track(0, a, colour(cv::Rect(0, 0, 160, 120))); }),
+              HasSubstr("right image"));
+  EXPECT_NO_THROW(tracker.track(0, a, a));
+  EXPECT_THAT(invalidInput([&] { tracker.track(1, b, b); }), HasSubstr("size changed"));
+  tracker.reset();
+  EXPECT_NO_THROW(tracker.track(2, b, b));
+}
+
+// The demo dataset's 64 x 24 images are smaller than the pyramid asks for: no crash, sane output.
+TEST(FeatureTrackerImages, TinyImagesWork) {
+  cv::Mat img(24, 64, CV_8UC1);
+  cv::RNG rng(3);
+  rng.fill(img, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(img, img, cv::Size(3, 3), 0.8);
+  FeatureTracker tracker{TrackerConfig{}};
+  const TrackedFrame first = tracker.track(0, img, img);
+  const TrackedFrame second = tracker.track(1, img, img);
+  EXPECT_GT(first.features.size(), 0u);
+  EXPECT_EQ(second.stats.tracked, static_cast<int>(first.features.size()));
+  for (const Feature& f : second.features) {
+    if (f.has_right) {
+      EXPECT_NEAR((f.px_right - f.px_left).norm(), 0.0, 0.1);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace gvio::test
