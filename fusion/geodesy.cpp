@@ -1,8 +1,12 @@
 #include "fusion/geodesy.hpp"
 
 #include <GeographicLib/Geocentric.hpp>
+#include <GeographicLib/UTMUPS.hpp>
 
 #include <cmath>
+#include <string>
+
+#include "odometry/error.hpp"
 
 namespace gvio::fusion {
 namespace {
@@ -47,6 +51,34 @@ bool isValidLla(const Lla& lla) {
   return std::isfinite(lla.lat_deg) && std::isfinite(lla.lon_deg) &&
          std::isfinite(lla.h_ellipsoid_m) && std::abs(lla.lat_deg) <= 90.0 &&
          std::abs(lla.lon_deg) <= 180.0;
+}
+
+Utm llaToUtm(const Lla& lla) {
+  if (!isValidLla(lla) || lla.lat_deg < -80.0 || lla.lat_deg >= 84.0) {
+    throw InvalidInput("UTM is defined for latitudes -80..84 deg (got " +
+                       std::to_string(lla.lat_deg) + ")");
+  }
+  return llaToUtm(lla, GeographicLib::UTMUPS::StandardZone(lla.lat_deg, lla.lon_deg));
+}
+
+Utm llaToUtm(const Lla& lla, int zone) {
+  if (zone < 1 || zone > 60)
+    throw InvalidInput("UTM zone must be 1..60 (got " + std::to_string(zone) + ")");
+  Utm utm;
+  int used_zone = 0;
+  double gamma = 0.0, k = 0.0;  // meridian convergence and scale: not needed here
+  GeographicLib::UTMUPS::Forward(lla.lat_deg, lla.lon_deg, used_zone, utm.north, utm.easting_m,
+                                 utm.northing_m, gamma, k, zone);
+  utm.zone = used_zone;
+  return utm;
+}
+
+Lla utmToLla(const Utm& utm, double h_ellipsoid_m) {
+  Lla lla;
+  lla.h_ellipsoid_m = h_ellipsoid_m;
+  GeographicLib::UTMUPS::Reverse(utm.zone, utm.north, utm.easting_m, utm.northing_m, lla.lat_deg,
+                                 lla.lon_deg);
+  return lla;
 }
 
 }  // namespace gvio::fusion

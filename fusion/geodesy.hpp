@@ -32,4 +32,19 @@ class EnuFrame {
 // True when lat/lon/h are finite and lat in [-90, 90], lon in [-180, 180].
 bool isValidLla(const Lla& lla);
 
+// A position in the Universal Transverse Mercator grid (WGS84), for map exports (LAS, GIS).
+struct Utm {
+  int zone = 0;       // 1..60
+  bool north = true;  // hemisphere
+  double easting_m = 0.0, northing_m = 0.0;
+  int epsg() const { return (north ? 32600 : 32700) + zone; }  // WGS 84 / UTM zone NN N|S
+};
+
+// The standard zone of the point (GeographicLib UTMUPS::StandardZone, Norway/Svalbard rules
+// included); throws InvalidInput outside the UTM latitude band (-80..84 deg, i.e. UPS regions).
+Utm llaToUtm(const Lla& lla);
+// Forces a zone (e.g. one zone for a whole map that straddles a boundary).
+Utm llaToUtm(const Lla& lla, int zone);
+Lla utmToLla(const Utm& utm, double h_ellipsoid_m);
+
 }  // namespace gvio::fusion

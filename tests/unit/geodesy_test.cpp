@@ -1,5 +1,7 @@
 #include "fusion/geodesy.hpp"
 
+#include "odometry/error.hpp"
+
 #include <gtest/gtest.h>
 
 namespace gvio::fusion {
@@ -47,6 +49,39 @@ TEST(Geodesy, ValidLla) {
   EXPECT_FALSE(isValidLla({91, 0, 0}));
   EXPECT_FALSE(isValidLla({0, -181, 0}));
   EXPECT_FALSE(isValidLla({0, 0, std::nan("")}));
+}
+
+// Reference values from PROJ, an independent implementation:
+//   echo "48.98253 8.39035" | cs2cs -f "%.3f" EPSG:4326 EPSG:32632  -> 455393.182 5425692.788
+//   echo "-33.8688 151.2093" | cs2cs -f "%.3f" EPSG:4326 EPSG:32756 -> 334368.634 6250948.345
+// EPSG codes by definition (WGS 84 / UTM zone NN N = 326NN, S = 327NN).
+TEST(Geodesy, UtmOfKnownPoints) {
+  const Utm k = llaToUtm({48.98253, 8.39035, 116.4});
+  EXPECT_EQ(k.zone, 32);
+  EXPECT_TRUE(k.north);
+  EXPECT_EQ(k.epsg(), 32632);
+  EXPECT_NEAR(k.easting_m, 455393.182, 0.01);
+  EXPECT_NEAR(k.northing_m, 5425692.788, 0.01);
+  const Utm s = llaToUtm({-33.8688, 151.2093, 0});  // Sydney
+  EXPECT_EQ(s.zone, 56);
+  EXPECT_FALSE(s.north);
+  EXPECT_EQ(s.epsg(), 32756);
+  EXPECT_NEAR(s.easting_m, 334368.634, 0.01);
+  EXPECT_NEAR(s.northing_m, 6250948.345, 0.01);
+  EXPECT_EQ(llaToUtm({60.0, 5.0, 0}).zone, 32);  // Norway exception: zone 32V is widened
+}
+
+TEST(Geodesy, UtmRoundTripAndForcedZone) {
+  const Lla p{48.98253, 8.39035, 116.4};
+  const Lla q = utmToLla(llaToUtm(p), p.h_ellipsoid_m);
+  EXPECT_NEAR(q.lat_deg, p.lat_deg, 1e-9);
+  EXPECT_NEAR(q.lon_deg, p.lon_deg, 1e-9);
+  // A neighbouring zone still converts (with more scale error) and back.
+  const Utm forced = llaToUtm(p, 31);
+  EXPECT_EQ(forced.zone, 31);
+  EXPECT_NEAR(utmToLla(forced, 0).lat_deg, p.lat_deg, 1e-9);
+  EXPECT_THROW(llaToUtm({85.0, 0.0, 0.0}), InvalidInput);
+  EXPECT_THROW(llaToUtm(p, 0), InvalidInput);
 }
 
 }  // namespace
