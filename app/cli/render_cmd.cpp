@@ -2,12 +2,11 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <regex>
 
 #include "cli/app.hpp"
-#include "io/atomic_write.hpp"
+#include "io/image_loader.hpp"
 #include "io/input_error.hpp"
 #include "odometry/error.hpp"
 #include "render/framebuffer.hpp"
@@ -35,15 +34,11 @@ std::pair<int, int> parseSize(const std::string& text) {
   return {w, h};
 }
 
-void writePng(const std::string& file, const render::ImageRgba& image) {
+cv::Mat toBgr(const render::ImageRgba& image) {
   cv::Mat rgba(image.height, image.width, CV_8UC4, const_cast<std::uint8_t*>(image.rgba.data())),
       bgr;
   cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
-  std::vector<std::uint8_t> png;
-  cv::imencode(".png", bgr, png);
-  io::writeFileAtomic(file, [&](std::ostream& out) {
-    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
-  });
+  return bgr;
 }
 
 int runRender(const RenderCliOptions& o) {
@@ -65,7 +60,7 @@ int runRender(const RenderCliOptions& o) {
   const render::GpuScene gpu(spec.scene);
   render::ImageRgba image = renderer.renderColor(gpu, spec.camera, target);
   render::annotate(image, spec.annotations);
-  writePng(o.out, image);
+  io::writePng(o.out, toBgr(image));
   spdlog::info("wrote {} ({}x{}, view {})", o.out, width, height, o.view);
   return 0;
 }

@@ -9,10 +9,24 @@
 
 namespace gvio::io {
 
+std::filesystem::path temporarySibling(const std::filesystem::path& path, std::string_view suffix) {
+  return path.string() + ".tmp" + std::to_string(static_cast<long>(::getpid())) +
+         std::string(suffix);
+}
+
+void moveIntoPlace(const std::filesystem::path& tmp, const std::filesystem::path& path) {
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw InputError(path, 0, "cannot rename temporary file into place: " + ec.message());
+  }
+}
+
 void writeFileAtomic(const std::filesystem::path& path,
                      const std::function<void(std::ostream&)>& write) {
-  const std::filesystem::path tmp =
-      path.string() + ".tmp" + std::to_string(static_cast<long>(::getpid()));
+  const std::filesystem::path tmp = temporarySibling(path);
   auto discard = [&tmp] {
     std::error_code ignored;
     std::filesystem::remove(tmp, ignored);
@@ -34,12 +48,7 @@ void writeFileAtomic(const std::filesystem::path& path,
       throw InputError(path, 0, "write failed (disk full?)");
     }
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    discard();
-    throw InputError(path, 0, "cannot rename temporary file into place: " + ec.message());
-  }
+  moveIntoPlace(tmp, path);
 }
 
 void writeTextAtomic(const std::filesystem::path& path, std::string_view text) {

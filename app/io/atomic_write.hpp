@@ -14,4 +14,11 @@ void writeFileAtomic(const std::filesystem::path& path,
                      const std::function<void(std::ostream&)>& write);
 void writeTextAtomic(const std::filesystem::path& path, std::string_view text);
 
+// For writers that need a file path of their own (e.g. PCL's): the temporary sibling to write,
+// ending in `suffix` (some libraries choose the format by extension), and the rename into place
+// (the temporary is removed and InputError naming `path` thrown when that fails).
+std::filesystem::path temporarySibling(const std::filesystem::path& path,
+                                       std::string_view suffix = "");
+void moveIntoPlace(const std::filesystem::path& tmp, const std::filesystem::path& path);
+
 }  // namespace gvio::io

@@ -12,6 +12,7 @@
 
 #include <zlib.h>
 
+#include "io/atomic_write.hpp"
 #include "io/input_error.hpp"
 
 namespace gvio::io {
@@ -76,6 +77,16 @@ cv::Mat loadGrayImage(const std::filesystem::path& file, const CameraModel& came
                                  image.rows, camera.name, camera.width_px, camera.height_px));
   }
   return image;
+}
+
+void writePng(const std::filesystem::path& file, const cv::Mat& image) {
+  std::vector<std::uint8_t> png;
+  if (!cv::imencode(".png", image, png, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+    throw InputError(file, 0, "PNG encoding failed");
+  }
+  writeFileAtomic(file, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  });
 }
 
 }  // namespace gvio::io

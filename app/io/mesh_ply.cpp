@@ -4,8 +4,8 @@
 #include <pcl/conversions.h>
 #include <pcl/io/ply_io.h>
 #include <pcl/point_types.h>
-#include <unistd.h>
 
+#include "io/atomic_write.hpp"
 #include "io/input_error.hpp"
 
 namespace gvio::io {
@@ -25,20 +25,14 @@ void writeMeshPly(const std::filesystem::path& file, const TriangleMesh& mesh) {
     for (const std::uint32_t idx : t) face.vertices.push_back(static_cast<pcl::index_t>(idx));
     pm.polygons.push_back(face);
   }
-  // PCL writes to a path; write a temporary sibling and rename it into place.
-  const std::filesystem::path tmp =
-      file.string() + ".tmp" + std::to_string(static_cast<long>(::getpid())) + ".ply";
+  // PCL writes to a path (and picks the format by extension): a temporary sibling, then rename.
+  const std::filesystem::path tmp = temporarySibling(file, ".ply");
   if (pcl::io::savePLYFileBinary(tmp.string(), pm) != 0) {
     std::error_code ec;
     std::filesystem::remove(tmp, ec);
     throw InputError(file, 0, "cannot write (missing directory or no permission)");
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw InputError(file, 0, "cannot rename temporary file into place");
-  }
+  moveIntoPlace(tmp, file);
 }
 
 TriangleMesh readMeshPly(const std::filesystem::path& file) {

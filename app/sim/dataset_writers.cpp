@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "io/atomic_write.hpp"
@@ -29,16 +28,6 @@ void writeLines(const fs::path& file, const std::string& text) {
 }
 
 }  // namespace
-
-void writeGreyPng(const fs::path& file, const cv::Mat& image) {
-  std::vector<std::uint8_t> png;
-  if (!cv::imencode(".png", image, png, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
-    throw io::InputError(file, 0, "PNG encoding failed");
-  }
-  io::writeFileAtomic(file, [&](std::ostream& out) {
-    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
-  });
-}
 
 void writeKittiOxts(const fs::path& drive, const std::vector<ImuSimSample>& imu,
                     const ContinuousTrajectory& trajectory, const fusion::EnuFrame& enu) {

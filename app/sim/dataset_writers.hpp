@@ -15,9 +15,6 @@
 
 namespace gvio::sim {
 
-// Grey PNG, written atomically (fast compression: the simulator writes thousands).
-void writeGreyPng(const std::filesystem::path& file, const cv::Mat& image);
-
 // KITTI raw: oxts/data/%010d.txt + timestamps.txt, one record per IMU sample: true position and
 // attitude (ENU, KITTI's roll/pitch/yaw), true velocities, the simulated IMU in a*/w* fields.
 void writeKittiOxts(const std::filesystem::path& drive, const std::vector<ImuSimSample>& imu,

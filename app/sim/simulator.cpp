@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "io/atomic_write.hpp"
+#include "io/image_loader.hpp"
 #include "io/input_error.hpp"
 #include "io/kitti_calib.hpp"
 #include "io/mesh_ply.hpp"
@@ -218,7 +219,7 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
       const fs::path file =
           kitti ? kittiImagePath(r.out, ids[c], k) : eurocImagePath(r.out, ids[c], frame_t[k]);
       fs::create_directories(file.parent_path());
-      writeGreyPng(file, image);
+      io::writePng(file, image);
     }
     if (progress) progress(k + 1, frame_t.size());
   }
