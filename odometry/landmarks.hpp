@@ -1,0 +1,84 @@
+#pragma once
+// Landmarks of the sliding window: feature observations grouped by tracker id, each landmark
+// anchored in the first window frame that observed it, with its inverse depth there (the Ceres
+// parameter). Node-based storage keeps every inverse depth at a stable address for Ceres.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <vector>
+
+#include "odometry/reprojection_factor.hpp"
+
+namespace gvio::odometry {
+
+struct Observation {
+  std::uint64_t frame_uid = 0;
+  Eigen::Vector2d px_left = Eigen::Vector2d::Zero();
+  bool has_right = false;
+  Eigen::Vector2d px_right = Eigen::Vector2d::Zero();
+};
+
+struct Landmark {
+  std::uint64_t id = 0;
+  std::vector<Observation> observations;  // time order; [0] is the anchor
+  double inv_depth = 0.0;                 // 1/m along the anchor's left-camera z axis
+  bool has_depth = false;
+
+  [[nodiscard]] const Observation& anchor() const { return observations.front(); }
+  [[nodiscard]] const Observation* in(std::uint64_t frame_uid) const;
+};
+
+// Camera geometry shared by the window: rectified left (and right) pinhole views.
+struct StereoGeometry {
+  PinholeView left;
+  PinholeView right;  // valid when stereo
+  bool stereo = false;
+  double baseline_m = 0.0;
+
+  [[nodiscard]] Eigen::Vector3d bearing(const Eigen::Vector2d& px) const {
+    return {(px.x() - left.cx) / left.fx, (px.y() - left.cy) / left.fy, 1.0};
+  }
+};
+
+// Pose lookup of a window frame by uid (body in world); returns nullptr if not in the window.
+using PoseLookup = std::function<const double*(std::uint64_t frame_uid)>;
+
+class LandmarkMap {
+ public:
+  std::map<std::uint64_t, Landmark>& all() { return landmarks_; }
+  [[nodiscard]] const std::map<std::uint64_t, Landmark>& all() const { return landmarks_; }
+
+  // Appends an observation to an existing landmark; returns false when the id is unknown.
+  bool observe(std::uint64_t id, const Observation& obs);
+  // Creates a landmark anchored at obs (depth from the stereo disparity when in range).
+  void create(std::uint64_t id, const Observation& obs, const StereoGeometry& geometry,
+              double min_depth_m, double max_depth_m);
+
+  // World point of a landmark with depth.
+  [[nodiscard]] static Eigen::Vector3d worldPoint(const Landmark& lm, const double* anchor_pose,
+                                                  const StereoGeometry& geometry);
+  // Landmarks without depth (mono, or no stereo match) seen from two poses with enough parallax
+  // get a depth by linear triangulation (DLT) of the anchor and latest observations.
+  void triangulate(const PoseLookup& poses, const StereoGeometry& geometry, double min_depth_m,
+                   double max_depth_m);
+
+  // Removes every observation of a frame that leaves the window. Landmarks anchored there are
+  // re-anchored to their next observation (depth carried over from the current estimate:
+  // VINS-Mono's removeBackShiftDepth); landmarks left without observations are erased.
+  void removeFrame(std::uint64_t frame_uid, const PoseLookup& poses,
+                   const StereoGeometry& geometry);
+  // Drops observations whose reprojection error exceeds max_px (a bad anchor drops the landmark)
+  // and depths out of range. Returns the number of observations removed.
+  int rejectOutliers(const PoseLookup& poses, const StereoGeometry& geometry, double max_px,
+                     double min_depth_m, double max_depth_m);
+  // Number of landmarks with depth that are observed in frame_uid.
+  [[nodiscard]] int countObservedWithDepth(std::uint64_t frame_uid) const;
+  void clear() { landmarks_.clear(); }
+
+ private:
+  std::map<std::uint64_t, Landmark> landmarks_;
+};
+
+}  // namespace gvio::odometry

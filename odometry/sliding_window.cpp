@@ -1,0 +1,273 @@
+#include "odometry/sliding_window.hpp"
+
+#include <ceres/normal_prior.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include "odometry/imu_factor.hpp"
+
+namespace gvio::odometry {
+namespace {
+
+const Eigen::Vector3d kGravityW(0.0, 0.0, -kGravity_mps2);
+// Inverse depths are kept positive (a point behind the anchor camera is meaningless).
+constexpr double kMinInverseDepth = 1e-4;
+
+}  // namespace
+
+ImuBias WindowFrame::bias() const {
+  ImuBias b;
+  b.acc = Eigen::Map<const Eigen::Vector3d>(speed_bias.data() + 3);
+  b.gyr = Eigen::Map<const Eigen::Vector3d>(speed_bias.data() + 6);
+  return b;
+}
+
+void WindowFrame::setBias(const ImuBias& b) {
+  Eigen::Map<Eigen::Vector3d>{speed_bias.data() + 3} = b.acc;
+  Eigen::Map<Eigen::Vector3d>{speed_bias.data() + 6} = b.gyr;
+}
+
+SlidingWindow::SlidingWindow(const EstimatorConfig& config, const StereoGeometry& geometry)
+    : config_(config),
+      geometry_(geometry),
+      huber_(std::make_shared<ceres::HuberLoss>(config.huber_sigmas)) {}
+
+WindowFrame* SlidingWindow::find(std::uint64_t uid) const {
+  for (const auto& f : frames_) {
+    if (f->uid == uid) return f.get();
+  }
+  return nullptr;
+}
+
+PoseLookup SlidingWindow::poseLookup() const {
+  return [this](std::uint64_t uid) -> const double* {
+    const WindowFrame* f = find(uid);
+    return f == nullptr ? nullptr : f->pose.data();
+  };
+}
+
+int SlidingWindow::keyframeCount() const {
+  int n = 0;
+  for (const auto& f : frames_) n += f->keyframe ? 1 : 0;
+  return n;
+}
+
+bool SlidingWindow::usable(const Landmark& lm) {
+  return lm.has_depth && lm.observations.size() >= 2;
+}
+
+int SlidingWindow::landmarkFactors(Landmark& lm, const FactorSink& raw_sink) const {
+  if (!usable(lm)) return 0;
+  WindowFrame* anchor = find(lm.anchor().frame_uid);
+  if (anchor == nullptr) return 0;
+  int forwarded = 0;
+  const Eigen::Vector3d bearing = geometry_.bearing(lm.anchor().px_left);
+  const double sigma = config_.pixel_sigma_px;
+  const ceres::LossFunction* loss = huber_.get();
+  // A residual that cannot be evaluated at the current state (the point behind a camera after a
+  // poor prediction) would make Ceres abandon the whole solve: such observations sit this one out.
+  const FactorSink sink = [&raw_sink, &forwarded](std::shared_ptr<ceres::CostFunction> cost,
+                                                  const ceres::LossFunction* l,
+                                                  std::vector<double*> blocks) {
+    Eigen::Vector2d r;
+    if (!cost->Evaluate(blocks.data(), r.data(), nullptr)) return;
+    raw_sink(std::move(cost), l, std::move(blocks));
+    ++forwarded;
+  };
+  if (geometry_.stereo && lm.anchor().has_right) {
+    sink(std::make_shared<SameFrameReprojectionFactor>(
+             bearing, geometry_.left.T_b_c, geometry_.right, lm.anchor().px_right, sigma),
+         loss, {&lm.inv_depth});
+  }
+  for (std::size_t k = 1; k < lm.observations.size(); ++k) {
+    const Observation& o = lm.observations[k];
+    WindowFrame* f = find(o.frame_uid);
+    if (f == nullptr || f == anchor) continue;
+    sink(std::make_shared<ReprojectionFactor>(bearing, geometry_.left.T_b_c, geometry_.left,
+                                              o.px_left, sigma),
+         loss, {anchor->pose.data(), f->pose.data(), &lm.inv_depth});
+    if (geometry_.stereo && o.has_right) {
+      sink(std::make_shared<ReprojectionFactor>(bearing, geometry_.left.T_b_c, geometry_.right,
+                                                o.px_right, sigma),
+           loss, {anchor->pose.data(), f->pose.data(), &lm.inv_depth});
+    }
+  }
+  return forwarded;
+}
+
+void SlidingWindow::reintegrateIfNeeded() {
+  for (std::size_t k = 1; k < frames_.size(); ++k) {
+    auto& pre = frames_[k]->preintegration;
+    if (!pre) continue;
+    const ImuBias b = frames_[k - 1]->bias();
+    if (pre->needsReintegration(b)) pre->reintegrate(b);
+  }
+}
+
+SolveStats SlidingWindow::solve(bool use_imu) {
+  SolveStats stats;
+  if (frames_.empty()) return stats;
+  if (use_imu) reintegrateIfNeeded();
+  ceres::Problem::Options popts;
+  popts.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  popts.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  popts.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(popts);
+  std::vector<std::shared_ptr<ceres::CostFunction>> alive;  // the problem does not own them
+  const auto add = [&](std::shared_ptr<ceres::CostFunction> cost, const ceres::LossFunction* loss,
+                       std::vector<double*> blocks) {
+    problem.AddResidualBlock(cost.get(), const_cast<ceres::LossFunction*>(loss), blocks);
+    alive.push_back(std::move(cost));
+    ++stats.residual_blocks;
+  };
+
+  for (const auto& f : frames_) {
+    problem.AddParameterBlock(f->pose.data(), kPoseAmbient, &pose_manifold_);
+    if (use_imu) problem.AddParameterBlock(f->speed_bias.data(), kSpeedBiasSize);
+  }
+  if (use_imu) {
+    for (std::size_t k = 1; k < frames_.size(); ++k) {
+      WindowFrame& a = *frames_[k - 1];
+      WindowFrame& b = *frames_[k];
+      if (!b.preintegration) continue;
+      add(std::make_shared<ImuFactor>(b.preintegration, kGravityW), nullptr,
+          {a.pose.data(), a.speed_bias.data(), b.pose.data(), b.speed_bias.data()});
+    }
+  }
+  for (auto& [id, lm] : landmarks_.all()) {
+    if (landmarkFactors(lm, add) > 0) {
+      ++stats.landmarks;
+      problem.SetParameterLowerBound(&lm.inv_depth, 0, kMinInverseDepth);
+    }
+  }
+  if (prior_) {
+    std::vector<double*> blocks;
+    for (const auto& b : prior_->blocks) blocks.push_back(const_cast<double*>(b.original_address));
+    add(std::make_shared<MarginalizationFactor>(prior_), nullptr, blocks);
+  }
+  bool anchored = false;
+  for (const AnchorFactor& a : anchors_) {
+    if (a.speed_bias && !use_imu) continue;
+    add(a.cost, nullptr, a.blocks);
+    anchored = true;
+  }
+  if (!prior_ && !anchored) problem.SetParameterBlockConstant(frames_.front()->pose.data());
+  // A frame whose speed/bias no residual constrains (an IMU outage) is held at its prediction.
+  if (use_imu) {
+    for (std::size_t k = 0; k < frames_.size(); ++k) {
+      const bool linked_before = k > 0 && frames_[k]->preintegration;
+      const bool linked_after = k + 1 < frames_.size() && frames_[k + 1]->preintegration;
+      const bool in_prior = prior_ && prior_->blockIndex(frames_[k]->speed_bias.data()) >= 0;
+      if (!linked_before && !linked_after && !in_prior) {
+        problem.SetParameterBlockConstant(frames_[k]->speed_bias.data());
+      }
+    }
+  }
+
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_SCHUR;
+  options.trust_region_strategy_type = ceres::DOGLEG;
+  options.max_num_iterations = config_.max_iterations;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  stats.iterations = static_cast<int>(summary.iterations.size());
+  stats.converged = summary.termination_type == ceres::CONVERGENCE;
+  return stats;
+}
+
+void SlidingWindow::marginalizeOldest(bool use_imu) {
+  if (frames_.empty()) return;
+  WindowFrame& oldest = *frames_.front();
+  if (frames_.size() >= 2) {
+    Marginalizer m;
+    for (const auto& f : frames_) m.setManifold(f->pose.data(), &pose_manifold_);
+    // A block may only be marked when some residual names it.
+    bool pose_named = false, speed_bias_named = false;
+    if (prior_) {
+      std::vector<double*> blocks;
+      for (const auto& b : prior_->blocks) {
+        blocks.push_back(const_cast<double*>(b.original_address));
+      }
+      m.addResidualBlock(std::make_shared<MarginalizationFactor>(prior_), nullptr, blocks);
+      pose_named = prior_->blockIndex(oldest.pose.data()) >= 0;
+      speed_bias_named = prior_->blockIndex(oldest.speed_bias.data()) >= 0;
+    }
+    WindowFrame& next = *frames_[1];
+    if (use_imu && next.preintegration) {
+      m.addResidualBlock(
+          std::make_shared<ImuFactor>(next.preintegration, kGravityW), nullptr,
+          {oldest.pose.data(), oldest.speed_bias.data(), next.pose.data(), next.speed_bias.data()});
+      pose_named = speed_bias_named = true;
+    }
+    const auto sink = [&](std::shared_ptr<ceres::CostFunction> cost,
+                          const ceres::LossFunction* loss, std::vector<double*> blocks) {
+      // The loss is owned by the window and outlives the marginaliser.
+      m.addResidualBlock(std::move(cost), std::shared_ptr<const ceres::LossFunction>(huber_, loss),
+                         blocks);
+    };
+    for (auto& [id, lm] : landmarks_.all()) {
+      if (lm.anchor().frame_uid != oldest.uid) continue;
+      if (landmarkFactors(lm, sink) > 0) {
+        m.markForRemoval(&lm.inv_depth);
+        pose_named = true;
+      }
+    }
+    for (const AnchorFactor& a : anchors_) {
+      if (a.frame_uid != oldest.uid || (a.speed_bias && !use_imu)) continue;
+      m.addResidualBlock(a.cost, nullptr, a.blocks);
+      (a.speed_bias ? speed_bias_named : pose_named) = true;
+    }
+    if (pose_named) m.markForRemoval(oldest.pose.data());
+    if (speed_bias_named) m.markForRemoval(oldest.speed_bias.data());
+    try {
+      // Also replaces an old prior that did not involve the oldest frame (carried through).
+      prior_ = (pose_named || prior_) ? m.marginalize() : nullptr;
+    } catch (const std::exception&) {
+      // A degenerate linearisation (it should not happen) costs the prior, never the run.
+      prior_.reset();
+    }
+  } else {
+    prior_.reset();
+  }
+  std::erase_if(anchors_, [&](const AnchorFactor& a) { return a.frame_uid == oldest.uid; });
+  landmarks_.removeFrame(oldest.uid, poseLookup(), geometry_);
+  frames_.pop_front();
+}
+
+void SlidingWindow::dropNewest() {
+  if (frames_.empty()) return;
+  const std::uint64_t uid = frames_.back()->uid;
+  std::erase_if(anchors_, [uid](const AnchorFactor& a) { return a.frame_uid == uid; });
+  landmarks_.removeFrame(uid, poseLookup(), geometry_);
+  frames_.pop_back();
+}
+
+void SlidingWindow::clear() {
+  frames_.clear();
+  landmarks_.clear();
+  prior_.reset();
+  anchors_.clear();
+}
+
+void SlidingWindow::anchorOldest(const StartPrior& start) {
+  anchors_.clear();
+  if (frames_.empty()) return;
+  WindowFrame& f = *frames_.front();
+  anchors_.push_back({f.uid,
+                      std::make_shared<PosePriorFactor>(f.pose.data(), start.pose),
+                      {f.pose.data()},
+                      false});
+  if (!start.speed_bias) return;
+  Eigen::Matrix<double, 9, 1> inv_sigma;
+  inv_sigma << Eigen::Vector3d::Constant(1.0 / start.velocity_mps),
+      Eigen::Vector3d::Constant(1.0 / start.acc_bias_mps2),
+      Eigen::Vector3d::Constant(1.0 / start.gyr_bias_radps);
+  const ceres::Matrix A = inv_sigma.asDiagonal();
+  const ceres::Vector b = Eigen::Map<const Eigen::Matrix<double, 9, 1>>(f.speed_bias.data());
+  anchors_.push_back(
+      {f.uid, std::make_shared<ceres::NormalPrior>(A, b), {f.speed_bias.data()}, true});
+}
+
+}  // namespace gvio::odometry

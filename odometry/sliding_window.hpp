@@ -1,0 +1,112 @@
+#pragma once
+// The estimator's sliding window: frame states (pose, velocity and biases) at stable addresses,
+// the landmarks, the marginalisation prior, and the two operations on them: one Ceres solve of
+// reprojection + IMU + prior residuals, and the marginalisation of the oldest keyframe.
+#include <ceres/loss_function.h>
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "odometry/imu_preintegration.hpp"
+#include "odometry/landmarks.hpp"
+#include "odometry/marginalization.hpp"
+#include "odometry/pose_manifold.hpp"
+#include "odometry/prior_factor.hpp"
+#include "odometry/vio_config.hpp"
+
+namespace gvio::odometry {
+
+struct WindowFrame {
+  std::uint64_t uid = 0;
+  std::int64_t t_ns = 0;
+  bool keyframe = false;
+  std::array<double, 7> pose{0, 0, 0, 1, 0, 0, 0};  // PoseManifold layout
+  std::array<double, 9> speed_bias{};               // v_w, b_acc, b_gyr
+  // IMU from the previous window frame to this one; null for the first frame, without an IMU, or
+  // across an IMU outage.
+  std::shared_ptr<ImuPreintegration> preintegration;
+
+  [[nodiscard]] Eigen::Isometry3d T_w_b() const { return poseFromBlock(pose.data()); }
+  [[nodiscard]] Eigen::Map<Eigen::Vector3d> velocity() {
+    return Eigen::Map<Eigen::Vector3d>(speed_bias.data());
+  }
+  [[nodiscard]] ImuBias bias() const;
+  void setBias(const ImuBias& b);
+};
+
+// Uncertainty of the state a window starts from (the anchor priors on its oldest frame).
+struct StartPrior {
+  PoseSigmas pose;
+  bool speed_bias = false;  // also a prior on velocity and biases (IMU modes)
+  double velocity_mps = 1.0;
+  double acc_bias_mps2 = 0.1;
+  double gyr_bias_radps = 0.01;
+};
+
+struct SolveStats {
+  int landmarks = 0;
+  int residual_blocks = 0;
+  int iterations = 0;
+  bool converged = false;
+};
+
+class SlidingWindow {
+ public:
+  SlidingWindow(const EstimatorConfig& config, const StereoGeometry& geometry);
+
+  std::deque<std::unique_ptr<WindowFrame>>& frames() { return frames_; }
+  [[nodiscard]] const std::deque<std::unique_ptr<WindowFrame>>& frames() const { return frames_; }
+  LandmarkMap& landmarks() { return landmarks_; }
+  [[nodiscard]] const LandmarkMap& landmarks() const { return landmarks_; }
+  [[nodiscard]] const StereoGeometry& geometry() const { return geometry_; }
+  [[nodiscard]] PoseLookup poseLookup() const;
+  [[nodiscard]] int keyframeCount() const;
+  [[nodiscard]] bool hasPrior() const { return prior_ != nullptr; }
+
+  // One nonlinear least-squares solve. IMU residuals join when `use_imu` (then the speed/bias
+  // blocks are variables); without a prior the oldest pose is held fixed (the gauge).
+  SolveStats solve(bool use_imu);
+  // Folds the oldest frame (its pose, speed/bias, and the landmarks anchored in it) into the
+  // prior and removes it from the window.
+  void marginalizeOldest(bool use_imu);
+  // Removes the newest frame without keeping its information (a non-keyframe: VINS drops their
+  // visual measurements too; its IMU is re-integrated from the previous keyframe).
+  void dropNewest();
+  // Clears frames, landmarks and prior.
+  void clear();
+  void clearPrior() { prior_.reset(); }
+  // Anchors the oldest frame with Gaussian priors around its current state; they join the
+  // marginalisation prior when that frame leaves. Replaces anchors set before.
+  void anchorOldest(const StartPrior& prior);
+  // Landmarks usable by the optimisation (depth, and seen from two frames).
+  [[nodiscard]] static bool usable(const Landmark& lm);
+
+ private:
+  using FactorSink = std::function<void(std::shared_ptr<ceres::CostFunction>,
+                                        const ceres::LossFunction*, std::vector<double*>)>;
+  // Reprojection factors of one landmark (left, and right where matched) that evaluate at the
+  // current state; returns how many were handed to `sink`.
+  int landmarkFactors(Landmark& lm, const FactorSink& sink) const;
+  [[nodiscard]] WindowFrame* find(std::uint64_t uid) const;
+  void reintegrateIfNeeded();
+
+  EstimatorConfig config_;
+  StereoGeometry geometry_;
+  PoseManifold pose_manifold_;
+  std::shared_ptr<ceres::LossFunction> huber_;
+  std::deque<std::unique_ptr<WindowFrame>> frames_;
+  LandmarkMap landmarks_;
+  std::shared_ptr<const MarginalizationPrior> prior_;
+  struct AnchorFactor {
+    std::uint64_t frame_uid = 0;
+    std::shared_ptr<ceres::CostFunction> cost;
+    std::vector<double*> blocks;
+    bool speed_bias = false;  // on the speed/bias block (only in IMU solves)
+  };
+  std::vector<AnchorFactor> anchors_;
+};
+
+}  // namespace gvio::odometry

@@ -1,0 +1,58 @@
+#pragma once
+// Configuration of the sliding-window VIO estimator: plain structs with defaults and validate()
+// (parsed from YAML in app/ only).
+#include <string>
+
+#include "odometry/feature_tracker.hpp"
+#include "odometry/measurements.hpp"
+
+namespace gvio::odometry {
+
+enum class VioMode {
+  kStereoImu,  // default: stereo camera + IMU
+  kMonoImu,    // left camera + IMU (scale from the IMU)
+  kStereo,     // stereo camera only (e.g. KITTI sync drives: 10 Hz oxts is no IMU)
+};
+std::string toString(VioMode mode);
+// Parses "stereo-imu", "mono-imu", "stereo"; throws InvalidInput otherwise.
+VioMode parseVioMode(const std::string& name);
+[[nodiscard]] inline bool usesImu(VioMode m) {
+  return m != VioMode::kStereo;
+}
+[[nodiscard]] inline bool usesStereo(VioMode m) {
+  return m != VioMode::kMonoImu;
+}
+
+struct EstimatorConfig {
+  VioMode mode = VioMode::kStereoImu;
+  TrackerConfig tracker;
+  ImuNoise imu_noise;
+
+  int window_size = 10;                // keyframes in the sliding window
+  double keyframe_parallax_px = 10.0;  // mean parallax vs the last keyframe that makes a keyframe
+  int keyframe_min_tracked = 50;       // fewer tracked landmarks than this makes a keyframe
+  double pixel_sigma_px = 1.0;         // reprojection noise (1 sigma)
+  double huber_sigmas = 2.0;           // robust (Huber) loss threshold in sigmas
+  int max_iterations = 8;              // Ceres iterations per frame (no wall-clock limit: the
+                                       // estimator is deterministic)
+  double min_depth_m = 0.5;            // landmarks closer or further are not used
+  double max_depth_m = 80.0;
+  double max_reprojection_px = 3.0;  // landmarks with a larger residual after solving are dropped
+  double static_gyr_radps = 0.02;    // static detection: gyro/acc spread and pixel motion below
+  double static_acc_mps2 = 0.2;
+  double static_pixel_motion_px = 0.5;
+  double init_window_s = 1.0;      // frames used by the visual-inertial alignment
+  double max_imu_gap_s = 0.1;      // longer gaps without IMU: coast on the visual solution
+  int min_features_tracking = 15;  // fewer usable features: the frame is lost (coast/reinit)
+  // Priors on the state the IMU window starts from (after initialisation or a restart). With the
+  // vehicle driving straight, tilt and accelerometer bias are nearly indistinguishable (1 m/s^2 of
+  // bias = 5.8 deg of tilt), so a realistic bias prior is what keeps the tilt from drifting.
+  double init_tilt_sigma_deg = 1.0;
+  double init_velocity_sigma_mps = 0.5;
+  double acc_bias_prior_mps2 = 0.1;
+  double gyr_bias_prior_radps = 0.01;
+
+  void validate() const;  // throws InvalidInput naming the field
+};
+
+}  // namespace gvio::odometry

@@ -1,0 +1,426 @@
+#include "odometry/vio_estimator.hpp"
+
+#include <opencv2/calib3d.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "odometry/error.hpp"
+#include "odometry/vio_estimator_impl.hpp"
+
+namespace gvio::odometry {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// A frame further than this after the previous one is a time jump: the state is stale.
+constexpr double kTimeJumpS = 1.0;
+// Coasting on the IMU alone longer than this drifts too far: the window restarts instead.
+constexpr double kMaxCoastS = 2.0;
+// A keyframe at least this often bounds the preintegration length (and a standing vehicle).
+constexpr double kMaxKeyframeIntervalS = 1.0;
+// solvePnPRansac for the visual pose prediction.
+constexpr int kMinPnpPoints = 8;
+constexpr float kPnpReprojectionPx = 3.0F;
+
+PinholeView viewOf(const CameraModel& cam) {
+  PinholeView v;
+  v.fx = cam.fx;
+  v.fy = cam.fy;
+  v.cx = cam.cx;
+  v.cy = cam.cy;
+  v.T_b_c = cam.T_b_c;
+  return v;
+}
+
+void requireRectified(const CameraModel& cam) {
+  if (!(cam.fx > 0 && cam.fy > 0 && cam.width_px > 0 && cam.height_px > 0)) {
+    throw InvalidInput("vio: camera '" + cam.name + "' has invalid intrinsics or size");
+  }
+  for (double d : cam.distortion) {
+    if (d != 0.0) {
+      throw InvalidInput("vio: camera '" + cam.name +
+                         "' has lens distortion; the estimator needs rectified cameras");
+    }
+  }
+}
+
+StereoGeometry makeGeometry(const EstimatorConfig& config, const CameraModel& left,
+                            const std::optional<CameraModel>& right) {
+  requireRectified(left);
+  StereoGeometry g;
+  g.left = viewOf(left);
+  if (!usesStereo(config.mode)) return g;
+  if (!right) throw InvalidInput("vio: mode " + toString(config.mode) + " needs a right camera");
+  requireRectified(*right);
+  const Eigen::Isometry3d T_l_r = left.T_b_c.inverse() * right->T_b_c;
+  const bool same_k = std::abs(left.fx - right->fx) < 1e-6 &&
+                      std::abs(left.fy - right->fy) < 1e-6 &&
+                      std::abs(left.cx - right->cx) < 1e-6 && std::abs(left.cy - right->cy) < 1e-6;
+  const Eigen::Vector3d t = T_l_r.translation();
+  const bool rectified = (T_l_r.rotation() - Eigen::Matrix3d::Identity()).norm() < 1e-6 &&
+                         t.x() > 0.0 && std::hypot(t.y(), t.z()) < 1e-6 * t.x();
+  if (!same_k || !rectified || left.width_px != right->width_px ||
+      left.height_px != right->height_px) {
+    throw InvalidInput(
+        "vio: the stereo pair is not rectified (equal intrinsics, right camera displaced along "
+        "the left x axis only)");
+  }
+  g.stereo = true;
+  g.right = viewOf(*right);
+  g.baseline_m = t.x();
+  return g;
+}
+
+}  // namespace
+
+VioEstimator::Impl::Impl(const EstimatorConfig& c, const StereoGeometry& g)
+    : config(c),
+      geometry(g),
+      tracker([&] {
+        TrackerConfig t = c.tracker;
+        t.stereo = g.stereo;
+        return t;
+      }()),
+      window(c, g) {}
+
+void VioEstimator::Impl::event(std::int64_t t_ns, const std::string& kind,
+                               const std::string& message) {
+  events.push_back({t_ns, kind, message});
+}
+
+bool VioEstimator::Impl::checkTime(std::int64_t t_ns) {
+  if (last_frame_ns >= 0) {
+    const std::int64_t dt = t_ns - last_frame_ns;
+    if (dt <= 0) {
+      event(t_ns, "time_jump", "frame stamp not after the previous frame: frame ignored");
+      return false;
+    }
+    if (nominal_frame_ns == 0 || dt < nominal_frame_ns) nominal_frame_ns = dt;
+    if (static_cast<double>(dt) * 1e-9 > kTimeJumpS) {
+      restart(t_ns, "time_jump",
+              "time jump of " + std::to_string(static_cast<double>(dt) * 1e-9) +
+                  " s: restarting the window",
+              false);
+    } else if (nominal_frame_ns > 0 && dt > nominal_frame_ns * 3 / 2) {
+      event(t_ns, "dropped_frame",
+            std::to_string(dt / nominal_frame_ns - 1) + " frame(s) missing before this one");
+    }
+  }
+  last_frame_ns = t_ns;
+  return true;
+}
+
+void VioEstimator::Impl::restart(std::int64_t t_ns, const std::string& kind, const std::string& why,
+                                 bool keep_imu_alignment) {
+  event(t_ns, kind, why);
+  window.clear();
+  tracker.reset();
+  if (!keep_imu_alignment) imu_aligned = false;
+  coast_start_ns = -1;
+  previous_pose.reset();
+  if (keep_imu_alignment && latest.valid) ++counters.initializations;
+}
+
+FrameResult VioEstimator::Impl::coast(std::int64_t t_ns, const std::string& why) {
+  FrameResult r;
+  r.t_ns = t_ns;
+  ++counters.lost_frames;
+  const bool can_coast =
+      imuActive() && latest.valid &&
+      imu.covers(latest.t_ns, t_ns, static_cast<std::int64_t>(config.max_imu_gap_s * 1e9));
+  if (!can_coast) {
+    if (!window.frames().empty()) {
+      restart(t_ns, "lost", why + ": tracking lost, restarting at the last estimate", imuActive());
+    }
+    return r;
+  }
+  if (coast_start_ns < 0) {
+    coast_start_ns = t_ns;
+    event(t_ns, "coasting", why + ": propagating on the IMU alone");
+  }
+  auto pre = imu.preintegrate(latest.t_ns, t_ns, latest.bias, config.imu_noise);
+  const Eigen::Vector3d g(0, 0, -kGravity_mps2);
+  const double dt = pre->deltaT();
+  const Eigen::Matrix3d R = latest.T_w_b.rotation();
+  previous_pose = latest.T_w_b;
+  latest.T_w_b.translation() += latest.v_w * dt + 0.5 * g * dt * dt + R * pre->deltaP();
+  latest.v_w += g * dt + R * pre->deltaV();
+  latest.T_w_b.linear() = R * pre->deltaR();
+  latest.t_ns = t_ns;
+  ++counters.coasted_frames;
+  if (static_cast<double>(t_ns - coast_start_ns) * 1e-9 > kMaxCoastS) {
+    restart(t_ns, "reinitialized", "coasted longer than 2 s: window restarted at the IMU estimate",
+            true);
+  }
+  r.initialized = true;
+  r.T_w_b = latest.T_w_b;
+  r.v_w_mps = latest.v_w;
+  r.bias = latest.bias;
+  return r;
+}
+
+std::optional<Eigen::Isometry3d> VioEstimator::Impl::predictVisual(
+    const TrackedFrame& tracked) const {
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  const PoseLookup poses = window.poseLookup();
+  for (const Feature& f : tracked.features) {
+    auto it = window.landmarks().all().find(f.id);
+    if (it == window.landmarks().all().end() || !it->second.has_depth) continue;
+    const double* anchor = poses(it->second.anchor().frame_uid);
+    if (anchor == nullptr) continue;
+    const Eigen::Vector3d p_w = LandmarkMap::worldPoint(it->second, anchor, geometry);
+    object.emplace_back(p_w.x(), p_w.y(), p_w.z());
+    image.emplace_back(f.px_left.x(), f.px_left.y());
+  }
+  if (object.size() < static_cast<std::size_t>(kMinPnpPoints) || !latest.valid) return std::nullopt;
+  // Initial guess: constant velocity from the last two estimates.
+  Eigen::Isometry3d guess = latest.T_w_b;
+  if (previous_pose) guess = latest.T_w_b * (previous_pose->inverse() * latest.T_w_b);
+  const Eigen::Isometry3d T_c_w = (guess * geometry.left.T_b_c).inverse();
+  cv::Mat K = (cv::Mat_<double>(3, 3) << geometry.left.fx, 0, geometry.left.cx, 0, geometry.left.fy,
+               geometry.left.cy, 0, 0, 1);
+  cv::Mat R_cv(3, 3, CV_64F), rvec, tvec(3, 1, CV_64F);
+  for (int r = 0; r < 3; ++r) {
+    tvec.at<double>(r) = T_c_w.translation()(r);
+    for (int c = 0; c < 3; ++c) R_cv.at<double>(r, c) = T_c_w.linear()(r, c);
+  }
+  cv::Rodrigues(R_cv, rvec);
+  std::vector<int> inliers;
+  const bool ok = cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, true, 100,
+                                     kPnpReprojectionPx, 0.99, inliers, cv::SOLVEPNP_ITERATIVE);
+  if (!ok || inliers.size() < static_cast<std::size_t>(kMinPnpPoints)) return guess;
+  cv::Rodrigues(rvec, R_cv);
+  Eigen::Isometry3d T_c_w_new = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    T_c_w_new.translation()(r) = tvec.at<double>(r);
+    for (int c = 0; c < 3; ++c) T_c_w_new.linear()(r, c) = R_cv.at<double>(r, c);
+  }
+  return T_c_w_new.inverse() * geometry.left.T_b_c.inverse();
+}
+
+std::unique_ptr<WindowFrame> VioEstimator::Impl::predictFrame(std::int64_t t_ns,
+                                                              const TrackedFrame& tracked) {
+  auto f = std::make_unique<WindowFrame>();
+  f->uid = next_uid++;
+  f->t_ns = t_ns;
+  const auto max_hold = static_cast<std::int64_t>(config.max_imu_gap_s * 1e9);
+  const auto& frames = window.frames();
+  if (usesImu(config.mode) && !frames.empty() && imu.covers(frames.back()->t_ns, t_ns, max_hold)) {
+    const double gap = imu.largestGapS(frames.back()->t_ns, t_ns);
+    if (gap > config.max_imu_gap_s) {
+      ++counters.imu_gaps;
+      event(t_ns, "imu_gap", "IMU gap of " + std::to_string(gap) + " s bridged by interpolation");
+    }
+    f->preintegration =
+        imu.preintegrate(frames.back()->t_ns, t_ns, frames.back()->bias(), config.imu_noise);
+  } else if (usesImu(config.mode) && !frames.empty()) {
+    ++counters.imu_gaps;
+    event(t_ns, "imu_gap", "no IMU data up to this frame: visual constraints only");
+  }
+
+  if (imuActive() && latest.valid && imu.covers(latest.t_ns, t_ns, max_hold)) {
+    // IMU propagation of the latest state (Forster eq. 33).
+    auto pre = imu.preintegrate(latest.t_ns, t_ns, latest.bias, config.imu_noise);
+    const Eigen::Vector3d g(0, 0, -kGravity_mps2);
+    const double dt = pre->deltaT();
+    const Eigen::Matrix3d R = latest.T_w_b.rotation();
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = R * pre->deltaR();
+    T.translation() =
+        latest.T_w_b.translation() + latest.v_w * dt + 0.5 * g * dt * dt + R * pre->deltaP();
+    poseToBlock(T, f->pose.data());
+    f->velocity() = latest.v_w + g * dt + R * pre->deltaV();
+    f->setBias(latest.bias);
+    return f;
+  }
+  Eigen::Isometry3d T = latest.valid ? latest.T_w_b : Eigen::Isometry3d::Identity();
+  if (latest.valid) {
+    if (auto visual = predictVisual(tracked)) T = *visual;
+  }
+  poseToBlock(T, f->pose.data());
+  f->velocity() = latest.valid ? latest.v_w : Eigen::Vector3d::Zero();
+  f->setBias(latest.bias);
+  return f;
+}
+
+bool VioEstimator::Impl::isKeyframe(const WindowFrame& f, const TrackedFrame& tracked) const {
+  const auto& frames = window.frames();
+  if (frames.empty()) return true;
+  const WindowFrame& last_kf = *frames.back();
+  if (static_cast<double>(f.t_ns - last_kf.t_ns) * 1e-9 >= kMaxKeyframeIntervalS) return true;
+  int tracked_landmarks = 0;
+  double parallax_sum = 0.0;
+  for (const Feature& feat : tracked.features) {
+    auto it = window.landmarks().all().find(feat.id);
+    if (it == window.landmarks().all().end()) continue;
+    const Observation* o = it->second.in(last_kf.uid);
+    if (o == nullptr) continue;
+    ++tracked_landmarks;
+    parallax_sum += (feat.px_left - o->px_left).norm();
+  }
+  if (tracked_landmarks < config.keyframe_min_tracked) return true;
+  return parallax_sum / tracked_landmarks >= config.keyframe_parallax_px;
+}
+
+void VioEstimator::Impl::addObservations(const WindowFrame& f, const TrackedFrame& tracked) {
+  for (const Feature& feat : tracked.features) {
+    Observation o;
+    o.frame_uid = f.uid;
+    o.px_left = feat.px_left;
+    o.has_right = geometry.stereo && feat.has_right;
+    o.px_right = feat.px_right;
+    if (window.landmarks().observe(feat.id, o)) continue;
+    if (f.keyframe) {
+      window.landmarks().create(feat.id, o, geometry, config.min_depth_m, config.max_depth_m);
+    }
+  }
+}
+
+void VioEstimator::Impl::anchorWindow() {
+  StartPrior start;
+  // Vision alone: the first pose is the gauge (all six degrees held). With the IMU aligned, tilt
+  // is observable and keeps the uncertainty of its initial estimate.
+  start.pose.tilt_rad = imuActive() ? config.init_tilt_sigma_deg * M_PI / 180.0 : 1e-4;
+  start.speed_bias = imuActive();
+  start.velocity_mps = config.init_velocity_sigma_mps;
+  start.acc_bias_mps2 = config.acc_bias_prior_mps2;
+  start.gyr_bias_radps = config.gyr_bias_prior_radps;
+  window.anchorOldest(start);
+}
+
+FrameResult VioEstimator::Impl::process(std::int64_t t_ns, const TrackedFrame& tracked) {
+  if (static_cast<int>(tracked.features.size()) < config.min_features_tracking) {
+    return coast(t_ns, std::to_string(tracked.features.size()) + " features");
+  }
+  if (coast_start_ns >= 0) {
+    event(t_ns, "coasting",
+          "tracking recovered after " +
+              std::to_string(static_cast<double>(t_ns - coast_start_ns) * 1e-9) + " s");
+    coast_start_ns = -1;
+  }
+  auto frame = predictFrame(t_ns, tracked);
+  frame->keyframe = isKeyframe(*frame, tracked);
+  addObservations(*frame, tracked);
+  window.frames().push_back(std::move(frame));
+  WindowFrame& f = *window.frames().back();
+  if (window.frames().size() == 1) {
+    anchorWindow();
+    if (!usesImu(config.mode)) {
+      ++counters.initializations;
+      event(t_ns, "initialized", "stereo window started (metric depth from the stereo pair)");
+    }
+  }
+  window.landmarks().triangulate(window.poseLookup(), geometry, config.min_depth_m,
+                                 config.max_depth_m);
+
+  const SolveStats stats = window.solve(imuActive());
+  window.landmarks().rejectOutliers(window.poseLookup(), geometry, config.max_reprojection_px,
+                                    config.min_depth_m, config.max_depth_m);
+  if (usesImu(config.mode) && !imu_aligned && tryInitialize(t_ns, tracked)) {
+    window.solve(true);
+  }
+
+  FrameResult r;
+  r.t_ns = t_ns;
+  r.initialized = !usesImu(config.mode) || imu_aligned;
+  r.T_w_b = f.T_w_b();
+  r.v_w_mps = f.velocity();
+  r.bias = f.bias();
+  r.keyframe = f.keyframe;
+  r.features = static_cast<int>(tracked.features.size());
+  r.landmarks_in_window = stats.landmarks;
+  finishFrame(f);
+  return r;
+}
+
+void VioEstimator::Impl::finishFrame(const WindowFrame& f) {
+  if (latest.valid) previous_pose = latest.T_w_b;
+  latest.valid = true;
+  latest.t_ns = f.t_ns;
+  latest.T_w_b = f.T_w_b();
+  latest.v_w = Eigen::Map<const Eigen::Vector3d>(f.speed_bias.data());
+  latest.bias = f.bias();
+  if (f.keyframe) {
+    ++counters.keyframes;
+    while (window.keyframeCount() > config.window_size) window.marginalizeOldest(imuActive());
+  } else {
+    window.dropNewest();
+  }
+  // IMU still needed: from the newest window frame on, and the static-detection interval.
+  std::int64_t keep = latest.t_ns - static_cast<std::int64_t>(config.init_window_s * 1e9);
+  if (!window.frames().empty()) keep = std::min(keep, window.frames().back()->t_ns);
+  imu.dropBefore(std::min(keep, latest.t_ns));
+}
+
+VioEstimator::VioEstimator(const EstimatorConfig& config, const CameraModel& left,
+                           const std::optional<CameraModel>& right) {
+  config.validate();
+  impl_ = std::make_unique<Impl>(config, makeGeometry(config, left, right));
+}
+
+VioEstimator::~VioEstimator() = default;
+VioEstimator::VioEstimator(VioEstimator&&) noexcept = default;
+VioEstimator& VioEstimator::operator=(VioEstimator&&) noexcept = default;
+
+void VioEstimator::addImu(const ImuSample& sample) {
+  if (!usesImu(impl_->config.mode)) return;
+  if (!impl_->imu.add(sample)) {
+    impl_->event(sample.t_ns, "imu_gap", "IMU sample out of order or not finite: ignored");
+  }
+}
+
+FrameResult VioEstimator::addFrame(std::int64_t t_ns, const cv::Mat& left, const cv::Mat& right) {
+  Impl& s = *impl_;
+  ++s.counters.frames;
+  FrameResult r;
+  r.t_ns = t_ns;
+  if (!s.checkTime(t_ns)) return r;
+  const auto start = Clock::now();
+  const TrackedFrame tracked = s.tracker.track(t_ns, left, s.geometry.stereo ? right : cv::Mat());
+  const double ms_tracking = msSince(start);
+  const auto start_estimator = Clock::now();
+  r = s.process(t_ns, tracked);
+  r.ms_tracking = ms_tracking;
+  r.ms_estimator = msSince(start_estimator);
+  if (!r.T_w_b.matrix().allFinite() || !r.v_w_mps.allFinite()) {
+    // Never hand out NaN: restart and report the frame as not estimated.
+    s.restart(t_ns, "reinitialized", "non-finite estimate: window restarted", false);
+    s.latest.valid = false;
+    r.initialized = false;
+  }
+  return r;
+}
+
+std::vector<VioEvent> VioEstimator::takeEvents() {
+  return std::exchange(impl_->events, {});
+}
+
+const VioCounters& VioEstimator::counters() const {
+  return impl_->counters;
+}
+
+std::vector<LandmarkEstimate> VioEstimator::landmarks() const {
+  std::vector<LandmarkEstimate> out;
+  const SlidingWindow& w = impl_->window;
+  const PoseLookup poses = w.poseLookup();
+  for (const auto& [id, lm] : w.landmarks().all()) {
+    if (!SlidingWindow::usable(lm)) continue;
+    const double* anchor = poses(lm.anchor().frame_uid);
+    if (anchor == nullptr) continue;
+    LandmarkEstimate e;
+    e.id = id;
+    e.p_w = LandmarkMap::worldPoint(lm, anchor, w.geometry());
+    e.observations = static_cast<int>(lm.observations.size());
+    out.push_back(e);
+  }
+  return out;
+}
+
+}  // namespace gvio::odometry

@@ -1,0 +1,95 @@
+#pragma once
+// Tightly coupled sliding-window visual-inertial odometry (VINS-Mono/Fusion and OKVIS in spirit,
+// Qin et al. 2018; Leutenegger et al. 2015): KLT front end, IMU preintegration (Forster 2017),
+// Ceres optimisation of reprojection + IMU residuals over a window of keyframes, and
+// marginalisation of leaving keyframes into a linear prior by Schur complement.
+//
+// Input contract: IMU samples and frames arrive in time order (IMU up to a frame's stamp before
+// that frame). Cameras must be rectified pinhole cameras (no distortion; for stereo the right
+// camera differs from the left only by a translation along the left x axis): app/ rectifies
+// raw cameras with odometry::Rectifier first. The estimator never throws on odd data (black
+// frames, gaps, time jumps): it coasts or reinitialises and records an event.
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "odometry/imu_preintegration.hpp"
+#include "odometry/measurements.hpp"
+#include "odometry/vio_config.hpp"
+
+namespace gvio::odometry {
+
+// Something the estimator did that a user should know about (report.json "events").
+struct VioEvent {
+  std::int64_t t_ns = 0;
+  std::string kind;     // "initialized", "reinitialized", "lost", "coasting", "imu_gap",
+                        // "time_jump", "dropped_frame", "black_frame", "waiting"
+  std::string message;  // one human-readable line
+};
+
+struct FrameResult {
+  std::int64_t t_ns = 0;
+  // False until the estimator has initialised (then the fields below are meaningless).
+  bool initialized = false;
+  Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();  // body (IMU) in the VIO world
+  Eigen::Vector3d v_w_mps = Eigen::Vector3d::Zero();
+  ImuBias bias;
+  bool keyframe = false;
+  int features = 0;             // features tracked in this frame
+  int landmarks_in_window = 0;  // landmarks used by the optimisation
+  // Wall-clock time of the two stages for this frame (informational, for report.json).
+  double ms_tracking = 0.0;
+  double ms_estimator = 0.0;
+};
+
+// A landmark of the window (for maps): position in the VIO world and its support.
+struct LandmarkEstimate {
+  std::uint64_t id = 0;
+  Eigen::Vector3d p_w = Eigen::Vector3d::Zero();
+  int observations = 0;
+  double mean_reprojection_px = 0.0;
+};
+
+struct VioCounters {
+  int frames = 0;
+  int keyframes = 0;
+  int initializations = 0;  // first initialisation included
+  int lost_frames = 0;      // frames with too few features to estimate
+  int coasted_frames = 0;   // frames propagated on the IMU alone
+  int imu_gaps = 0;
+};
+
+class VioEstimator {
+ public:
+  // `left` always; `right` for the stereo modes. T_b_c of each camera is the camera in the body
+  // (IMU) frame. Throws InvalidInput for an invalid config or cameras that break the contract.
+  VioEstimator(const EstimatorConfig& config, const CameraModel& left,
+               const std::optional<CameraModel>& right);
+  ~VioEstimator();
+  VioEstimator(const VioEstimator&) = delete;
+  VioEstimator& operator=(const VioEstimator&) = delete;
+  VioEstimator(VioEstimator&&) noexcept;
+  VioEstimator& operator=(VioEstimator&&) noexcept;
+
+  // Ignored (but counted) in the stereo-only mode.
+  void addImu(const ImuSample& sample);
+  // 8-bit grey images of the calibrated size (right empty in mono mode).
+  FrameResult addFrame(std::int64_t t_ns, const cv::Mat& left, const cv::Mat& right = cv::Mat());
+
+  // Events since the last call (moved out).
+  std::vector<VioEvent> takeEvents();
+  [[nodiscard]] const VioCounters& counters() const;
+  // Landmarks currently in the window with a valid depth.
+  [[nodiscard]] std::vector<LandmarkEstimate> landmarks() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace gvio::odometry

@@ -1,0 +1,70 @@
+#pragma once
+// Internal state of VioEstimator (shared by vio_estimator.cpp and vio_initialization.cpp).
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "odometry/feature_tracker.hpp"
+#include "odometry/imu_buffer.hpp"
+#include "odometry/sliding_window.hpp"
+#include "odometry/vio_estimator.hpp"
+
+namespace gvio::odometry {
+
+// The latest estimate of any frame (also of non-keyframes, which leave the window).
+struct LatestState {
+  bool valid = false;
+  std::int64_t t_ns = 0;
+  Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d v_w = Eigen::Vector3d::Zero();
+  ImuBias bias;
+};
+
+struct VioEstimator::Impl {
+  Impl(const EstimatorConfig& c, const StereoGeometry& g);
+
+  FrameResult process(std::int64_t t_ns, const TrackedFrame& tracked);
+
+  // Stages of process().
+  bool checkTime(std::int64_t t_ns);
+  FrameResult coast(std::int64_t t_ns, const std::string& why);
+  std::unique_ptr<WindowFrame> predictFrame(std::int64_t t_ns, const TrackedFrame& tracked);
+  std::optional<Eigen::Isometry3d> predictVisual(const TrackedFrame& tracked) const;
+  bool isKeyframe(const WindowFrame& f, const TrackedFrame& tracked) const;
+  void addObservations(const WindowFrame& f, const TrackedFrame& tracked);
+  void finishFrame(const WindowFrame& f);
+  // Restarts the window at the latest estimate (lost tracking, long coasting, time jumps).
+  void restart(std::int64_t t_ns, const std::string& kind, const std::string& why,
+               bool keep_imu_alignment);
+  // Anchors a window that just started (gauge and initial-state priors).
+  void anchorWindow();
+  void event(std::int64_t t_ns, const std::string& kind, const std::string& message);
+
+  // vio_initialization.cpp: gravity alignment of the visual window (static or in motion).
+  bool tryInitialize(std::int64_t t_ns, const TrackedFrame& tracked);
+  bool staticInitialize(std::int64_t t_ns, const TrackedFrame& tracked);
+  bool motionInitialize(std::int64_t t_ns);
+  void applyAlignment(const Eigen::Matrix3d& R_w_v, const std::vector<Eigen::Vector3d>& v_v,
+                      const ImuBias& bias);
+
+  [[nodiscard]] bool imuActive() const { return usesImu(config.mode) && imu_aligned; }
+
+  EstimatorConfig config;
+  StereoGeometry geometry;
+  FeatureTracker tracker;
+  ImuBuffer imu;
+  SlidingWindow window;
+  LatestState latest;
+  std::optional<Eigen::Isometry3d> previous_pose;  // the frame before `latest` (constant velocity)
+  bool imu_aligned = false;  // the window is gravity-aligned with velocities and biases
+  bool waiting_reported = false;
+  std::uint64_t next_uid = 1;
+  std::int64_t last_frame_ns = -1;
+  std::int64_t nominal_frame_ns = 0;
+  std::int64_t coast_start_ns = -1;
+  std::vector<VioEvent> events;
+  VioCounters counters;
+};
+
+}  // namespace gvio::odometry

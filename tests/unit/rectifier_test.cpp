@@ -1,0 +1,319 @@
+// odometry::Rectifier on synthetic rigs: a distorted EuRoC-like stereo pair with a rotation between
+// the cameras (rows align, and the rectified images sample the originals exactly where the
+// original models project a point), a distorted mono camera, and already rectified KITTI-like
+// cameras that pass through untouched.
+#include "odometry/rectifier.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+
+#include <random>
+
+#include "odometry/error.hpp"
+
+namespace gvio::odometry {
+namespace {
+using testing::HasSubstr;
+
+Eigen::Isometry3d pose(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  // Published calibrations are orthonormal to ~1e-9 only; Isometry3d::inverse assumes exactness.
+  T.linear() = Eigen::Quaterniond(R).normalized().toRotationMatrix();
+  T.translation() = t;
+  return T;
+}
+
+// EuRoC MAV cam0/cam1 (sensor.yaml): radial-tangential distortion, ~0.6 deg between the cameras.
+CameraModel eurocCam0() {
+  CameraModel c;
+  c.name = "cam0";
+  c.width_px = 752;
+  c.height_px = 480;
+  c.fx = 458.654, c.fy = 457.296, c.cx = 367.215, c.cy = 248.375;
+  c.distortion = {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05};
+  Eigen::Matrix3d R;
+  R << 0.0148655429818, -0.999880929698, 0.00414029679422, 0.999557249008, 0.0149672133247,
+      0.025715529948, -0.0257744366974, 0.00375618835797, 0.999660727178;
+  c.T_b_c = pose(R, {-0.0216401454975, -0.064676986768, 0.00981073058949});
+  return c;
+}
+
+CameraModel eurocCam1() {
+  CameraModel c;
+  c.name = "cam1";
+  c.width_px = 752;
+  c.height_px = 480;
+  c.fx = 457.587, c.fy = 456.134, c.cx = 379.999, c.cy = 255.238;
+  c.distortion = {-0.28368365, 0.07451284, -0.00010473, -3.55590700e-05};
+  Eigen::Matrix3d R;
+  R << 0.0125552670891, -0.999755099723, 0.0182237714554, 0.999598781151, 0.0130119051815,
+      0.0251588363115, -0.0253898008918, 0.0179005838253, 0.999517347078;
+  c.T_b_c = pose(R, {-0.0198435579556, 0.0453689425024, 0.00786212447038});
+  return c;
+}
+
+// KITTI's rectified grey pair: no distortion, one K, cam1 0.537 m along cam0's x axis.
+CameraModel kittiCam0() {
+  CameraModel c;
+  c.name = "image_00";
+  c.width_px = 1241;
+  c.height_px = 376;
+  c.fx = c.fy = 718.856, c.cx = 607.1928, c.cy = 185.2157;
+  Eigen::Matrix3d R;  // camera x right, y down, z forward in a body x forward, z up
+  R << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  c.T_b_c = pose(R, {1.08, -0.32, 0.73});
+  return c;
+}
+
+CameraModel kittiCam1() {
+  CameraModel c = kittiCam0();
+  c.name = "image_01";
+  c.T_b_c = c.T_b_c * Eigen::Translation3d(0.537, 0.0, 0.0);
+  return c;
+}
+
+Eigen::Vector2d projectPinhole(const CameraModel& cam, const Eigen::Vector3d& p_b) {
+  const Eigen::Vector3d p_c = cam.T_b_c.inverse() * p_b;
+  return {cam.fx * p_c.x() / p_c.z() + cam.cx, cam.fy * p_c.y() / p_c.z() + cam.cy};
+}
+
+// Through the original, distorted model, as OpenCV defines it.
+Eigen::Vector2d projectOriginal(const CameraModel& cam, const Eigen::Vector3d& p_b) {
+  const Eigen::Isometry3d T_c_b = cam.T_b_c.inverse();
+  cv::Mat R(3, 3, CV_64F), rvec, tvec(3, 1, CV_64F);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) R.at<double>(r, c) = T_c_b.linear()(r, c);
+    tvec.at<double>(r) = T_c_b.translation()(r);
+  }
+  cv::Rodrigues(R, rvec);
+  const cv::Mat K = (cv::Mat_<double>(3, 3) << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
+  std::vector<cv::Point2d> px;
+  cv::projectPoints(std::vector<cv::Point3d>{{p_b.x(), p_b.y(), p_b.z()}}, rvec, tvec, K,
+                    cam.distortion, px);
+  return {px[0].x, px[0].y};
+}
+
+bool inside(const CameraModel& cam, const Eigen::Vector2d& px, double margin) {
+  return px.x() >= margin && px.y() >= margin && px.x() <= cam.width_px - 1 - margin &&
+         px.y() <= cam.height_px - 1 - margin;
+}
+
+// Points in front of the rectified left camera (2-30 m), seen inside every image (original and
+// rectified, left and right) with a 2 px margin.
+std::vector<Eigen::Vector3d> visiblePoints(const Rectifier& rect, const CameraModel& raw_left,
+                                           const std::optional<CameraModel>& raw_right) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const CameraModel& left = rect.left();
+  std::vector<Eigen::Vector3d> points;
+  while (points.size() < 300) {
+    const double depth = 2.0 + 28.0 * u(rng);
+    const Eigen::Vector3d p_c((left.width_px * u(rng) - left.cx) / left.fx * depth,
+                              (left.height_px * u(rng) - left.cy) / left.fy * depth, depth);
+    const Eigen::Vector3d p_b = left.T_b_c * p_c;
+    bool ok = inside(left, projectPinhole(left, p_b), 2) &&
+              inside(raw_left, projectOriginal(raw_left, p_b), 2);
+    if (raw_right) {
+      ok = ok && inside(*rect.right(), projectPinhole(*rect.right(), p_b), 2) &&
+           inside(*raw_right, projectOriginal(*raw_right, p_b), 2);
+    }
+    if (ok) points.push_back(p_b);
+  }
+  return points;
+}
+
+// An image whose pixels hold their own x (or y) coordinate: after rectification, each pixel
+// holds the original position it sampled.
+cv::Mat coordinateImage(const CameraModel& cam, bool y) {
+  cv::Mat image(cam.height_px, cam.width_px, CV_32F);
+  for (int r = 0; r < image.rows; ++r) {
+    for (int c = 0; c < image.cols; ++c) image.at<float>(r, c) = static_cast<float>(y ? r : c);
+  }
+  return image;
+}
+
+double bilinear(const cv::Mat& image, const Eigen::Vector2d& px) {
+  const int x0 = static_cast<int>(std::floor(px.x())), y0 = static_cast<int>(std::floor(px.y()));
+  const double ax = px.x() - x0, ay = px.y() - y0;
+  auto at = [&](int x, int y) { return static_cast<double>(image.at<float>(y, x)); };
+  return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
+         ay * ((1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
+}
+
+// Where the rectified image of `which` camera samples the original at the rectified projection of
+// each point, against the original model's projection: the worst miss in px.
+double worstMapError(const Rectifier& rect, const CameraModel& raw_left,
+                     const std::optional<CameraModel>& raw_right, bool right_camera) {
+  const CameraModel& raw = right_camera ? *raw_right : raw_left;
+  const CameraModel& model = right_camera ? *rect.right() : rect.left();
+  RectifiedImages xs, ys;
+  if (raw_right) {
+    xs = rect.rectify(coordinateImage(raw_left, false), coordinateImage(*raw_right, false));
+    ys = rect.rectify(coordinateImage(raw_left, true), coordinateImage(*raw_right, true));
+  } else {
+    xs = rect.rectify(coordinateImage(raw_left, false));
+    ys = rect.rectify(coordinateImage(raw_left, true));
+  }
+  const cv::Mat& x_img = right_camera ? xs.right : xs.left;
+  const cv::Mat& y_img = right_camera ? ys.right : ys.left;
+  double worst = 0.0;
+  for (const Eigen::Vector3d& p_b : visiblePoints(rect, raw_left, raw_right)) {
+    const Eigen::Vector2d rectified = projectPinhole(model, p_b);
+    const Eigen::Vector2d sampled(bilinear(x_img, rectified), bilinear(y_img, rectified));
+    worst = std::max(worst, (sampled - projectOriginal(raw, p_b)).norm());
+  }
+  return worst;
+}
+
+TEST(RectifierTest, StereoRigGetsOneKAndRowAlignedCameras) {
+  const CameraModel raw_l = eurocCam0(), raw_r = eurocCam1();
+  const Rectifier rect(raw_l, raw_r);
+  EXPECT_FALSE(rect.isIdentity());
+  ASSERT_TRUE(rect.isStereo());
+  const CameraModel& l = rect.left();
+  const CameraModel& r = *rect.right();
+  EXPECT_TRUE(l.distortion.empty());
+  EXPECT_TRUE(r.distortion.empty());
+  EXPECT_EQ(l.width_px, 752);
+  EXPECT_EQ(r.height_px, 480);
+  EXPECT_EQ(r.name, "cam1");
+  EXPECT_DOUBLE_EQ(l.fx, r.fx);
+  EXPECT_DOUBLE_EQ(l.fy, r.fy);
+  EXPECT_DOUBLE_EQ(l.cx, r.cx);
+  EXPECT_DOUBLE_EQ(l.cy, r.cy);
+  // Rectification turns the cameras about their centres: the centres stay where they were.
+  EXPECT_LT((l.T_b_c.translation() - raw_l.T_b_c.translation()).norm(), 1e-12);
+  EXPECT_LT((r.T_b_c.translation() - raw_r.T_b_c.translation()).norm(), 1e-9);
+  const double raw_baseline = (raw_r.T_b_c.translation() - raw_l.T_b_c.translation()).norm();
+  EXPECT_NEAR(rect.baselineM(), raw_baseline, 1e-12);
+  EXPECT_NEAR(rect.baselineM(), 0.1101, 1e-3);
+  // The right camera differs from the left only by +baseline along the left x axis.
+  const Eigen::Isometry3d T_l_r = l.T_b_c.inverse() * r.T_b_c;
+  EXPECT_LT((T_l_r.linear() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+  EXPECT_LT((T_l_r.translation() - Eigen::Vector3d(rect.baselineM(), 0, 0)).norm(), 1e-12);
+  // Same row in both rectified images, disparity positive.
+  for (const Eigen::Vector3d& p_b : visiblePoints(rect, raw_l, raw_r)) {
+    const Eigen::Vector2d pl = projectPinhole(l, p_b), pr = projectPinhole(r, p_b);
+    EXPECT_NEAR(pl.y(), pr.y(), 0.05);
+    EXPECT_GT(pl.x(), pr.x());
+  }
+}
+
+// The rectified models and the rectified images agree: a point projected by a rectified model
+// lands on the pixel that was resampled from where the original model projects it.
+TEST(RectifierTest, StereoMapsSampleWhereOriginalModelsProject) {
+  const CameraModel raw_l = eurocCam0(), raw_r = eurocCam1();
+  const Rectifier rect(raw_l, raw_r);
+  EXPECT_LT(worstMapError(rect, raw_l, raw_r, false), 0.05);
+  EXPECT_LT(worstMapError(rect, raw_l, raw_r, true), 0.05);
+}
+
+TEST(RectifierTest, DistortedMonoCameraIsUndistorted) {
+  const CameraModel raw = eurocCam0();
+  const Rectifier rect(raw);
+  EXPECT_FALSE(rect.isIdentity());
+  EXPECT_FALSE(rect.isStereo());
+  EXPECT_FALSE(rect.right());
+  EXPECT_TRUE(rect.left().distortion.empty());
+  EXPECT_TRUE(rect.left().T_b_c.isApprox(raw.T_b_c, 1e-15));
+  EXPECT_LT(worstMapError(rect, raw, std::nullopt, false), 0.05);
+  // 8-bit grey in, 8-bit grey of the same size out, with no dark border or seam anywhere.
+  const cv::Mat grey(raw.height_px, raw.width_px, CV_8U, cv::Scalar(200));
+  const RectifiedImages out = rect.rectify(grey);
+  EXPECT_EQ(out.left.type(), CV_8U);
+  EXPECT_EQ(out.left.size(), grey.size());
+  EXPECT_TRUE(out.right.empty());
+  double lo = 0.0, hi = 0.0;
+  cv::minMaxLoc(out.left, &lo, &hi);
+  EXPECT_EQ(lo, 200.0);
+  EXPECT_EQ(hi, 200.0);
+}
+
+TEST(RectifierTest, RectifiedKittiPairPassesThrough) {
+  const CameraModel raw_l = kittiCam0(), raw_r = kittiCam1();
+  const Rectifier rect(raw_l, raw_r);
+  EXPECT_TRUE(rect.isIdentity());
+  EXPECT_NEAR(rect.baselineM(), 0.537, 1e-12);
+  EXPECT_DOUBLE_EQ(rect.left().fx, raw_l.fx);
+  EXPECT_DOUBLE_EQ(rect.right()->cx, raw_r.cx);
+  EXPECT_TRUE(rect.left().T_b_c.isApprox(raw_l.T_b_c, 1e-12));
+  EXPECT_TRUE(rect.right()->T_b_c.isApprox(raw_r.T_b_c, 1e-12));
+  const cv::Mat left(376, 1241, CV_8U, cv::Scalar(1)), right(376, 1241, CV_8U, cv::Scalar(2));
+  const RectifiedImages out = rect.rectify(left, right);
+  EXPECT_EQ(out.left.data, left.data);  // no copy, no remap
+  EXPECT_EQ(out.right.data, right.data);
+}
+
+// KITTI calibration files print rotations to 7 digits: the IMU chain gives both cameras the same
+// slightly non-orthonormal rotation. Still a rectified pair, and the models come out exact.
+TEST(RectifierTest, RoundedCalibrationRotationStillPassesThrough) {
+  CameraModel raw_l = kittiCam0();
+  Eigen::Matrix3d rounded = raw_l.T_b_c.linear();
+  rounded(0, 1) += 3e-7;
+  rounded(2, 0) -= 2e-7;
+  raw_l.T_b_c.linear() = rounded;
+  CameraModel raw_r = raw_l;
+  raw_r.name = "image_01";
+  raw_r.T_b_c.translation() += 0.537 * rounded.col(0);
+  const Rectifier rect(raw_l, raw_r);
+  EXPECT_TRUE(rect.isIdentity());
+  EXPECT_NEAR(rect.baselineM(), 0.537, 1e-6);
+  const Eigen::Matrix3d& R = rect.left().T_b_c.linear();
+  EXPECT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).norm(), 1e-14);
+  EXPECT_LT((R - rounded).norm(), 1e-6);
+  const Eigen::Isometry3d T_l_r = rect.left().T_b_c.inverse() * rect.right()->T_b_c;
+  EXPECT_LT((T_l_r.linear() - Eigen::Matrix3d::Identity()).norm(), 1e-14);
+  EXPECT_LT((T_l_r.translation() - Eigen::Vector3d(rect.baselineM(), 0, 0)).norm(), 1e-14);
+}
+
+TEST(RectifierTest, UndistortedMonoAndZeroDistortionAreIdentity) {
+  EXPECT_TRUE(Rectifier(kittiCam0()).isIdentity());
+  CameraModel zeros = kittiCam0();
+  zeros.distortion = {0, 0, 0, 0, 0};
+  const Rectifier rect(zeros);
+  EXPECT_TRUE(rect.isIdentity());
+  EXPECT_TRUE(rect.left().distortion.empty());
+  // Rotated by more than the tolerance: a real rectification, though nothing is distorted.
+  CameraModel turned = kittiCam1();
+  turned.T_b_c.rotate(Eigen::AngleAxisd(1e-3, Eigen::Vector3d::UnitY()));
+  const Rectifier rect2(kittiCam0(), turned);
+  EXPECT_FALSE(rect2.isIdentity());
+  EXPECT_LT(worstMapError(rect2, kittiCam0(), turned, true), 0.05);
+}
+
+std::string errorOf(const CameraModel& left, const std::optional<CameraModel>& right) {
+  try {
+    const Rectifier rect(left, right);
+  } catch (const InvalidInput& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(RectifierTest, RefusesInvalidCamerasAndRigs) {
+  EXPECT_THAT(errorOf(kittiCam1(), kittiCam0()), HasSubstr("right of the left"));
+  EXPECT_THAT(errorOf(eurocCam1(), eurocCam0()), HasSubstr("side by side"));
+  CameraModel above = kittiCam0();  // a vertical rig
+  above.T_b_c = above.T_b_c * Eigen::Translation3d(0.01, -0.5, 0.0);
+  EXPECT_THAT(errorOf(kittiCam0(), above), HasSubstr("side by side"));
+  CameraModel small = kittiCam1();
+  small.width_px = 640;
+  EXPECT_THAT(errorOf(kittiCam0(), small), HasSubstr("different image sizes"));
+  CameraModel three = kittiCam0();
+  three.distortion = {0.1, 0.01, 0.0};
+  EXPECT_THAT(errorOf(three, std::nullopt), HasSubstr("distortion coefficients"));
+  CameraModel no_focal = kittiCam0();
+  no_focal.fx = 0.0;
+  EXPECT_THAT(errorOf(no_focal, std::nullopt), HasSubstr("focal lengths"));
+
+  const Rectifier rect(eurocCam0(), eurocCam1());
+  const cv::Mat wrong(480, 640, CV_8U), ok(480, 752, CV_8U);
+  EXPECT_THROW((void)rect.rectify(wrong, ok), InvalidInput);
+  EXPECT_THROW((void)rect.rectify(ok), InvalidInput);  // stereo needs both images
+}
+
+}  // namespace
+}  // namespace gvio::odometry
