@@ -37,6 +37,25 @@ int runGuarded(const std::function<int()>& run) {
   }
 }
 
+// argv joined back into one line a shell would accept (report.json records how a run was made).
+std::string commandLine(int argc, char** argv) {
+  std::string line;
+  for (int i = 0; i < argc; ++i) {
+    std::string arg = argv[i];
+    const bool plain = !arg.empty() && arg.find_first_not_of(
+                                           "abcdefghijklmnopqrstuvwxyz"
+                                           "ABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                           "0123456789_-+=./:,@%") == std::string::npos;
+    if (!plain) {
+      std::string quoted = "'";
+      for (const char ch : arg) quoted += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+      arg = quoted + "'";
+    }
+    line += (i == 0 ? "" : " ") + arg;
+  }
+  return line;
+}
+
 }  // namespace
 
 ProgressStyle CommonOptions::progressStyle() const {
@@ -63,6 +82,7 @@ int runMain(int argc, char** argv) {
                "gvio"};
   app.set_version_flag("--version", std::string(GVIO_VERSION));
   CommonOptions common;
+  common.command_line = commandLine(argc, argv);
   app.add_flag("-v,--verbose", common.verbose, "More log output (-vv: trace)");
   app.add_flag("-q,--quiet", common.quiet,
                "Warnings and errors only (-qq: errors only), no progress");
@@ -77,6 +97,7 @@ int runMain(int argc, char** argv) {
   commands.push_back(addEvalCommand(app));
   commands.push_back(addRenderCommand(app));
   commands.push_back(addSimulateCommand(app, common));
+  commands.push_back(addRunCommand(app, common));
 
   try {
     app.parse(argc, argv);

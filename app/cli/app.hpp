@@ -17,6 +17,7 @@ struct CommonOptions {
   int verbose = 0;
   int quiet = 0;
   bool no_progress = false;
+  std::string command_line;  // the whole invocation, shell-quoted where needed (for reports)
 
   [[nodiscard]] ProgressStyle progressStyle() const;
 };
@@ -39,6 +40,7 @@ Command addInspectCommand(CLI::App& app, const CommonOptions& common);
 Command addEvalCommand(CLI::App& app);
 Command addRenderCommand(CLI::App& app);
 Command addSimulateCommand(CLI::App& app, const CommonOptions& common);
+Command addRunCommand(CLI::App& app, const CommonOptions& common);
 
 int runMain(int argc, char** argv);
 

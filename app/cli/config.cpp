@@ -153,13 +153,33 @@ void applyOverride(const std::string& assignment, std::map<std::string, ConfigKe
 
 }  // namespace
 
+void VioConfig::validate() const {
+  if (mode != "auto" && mode != "stereo-imu" && mode != "mono-imu" && mode != "stereo") {
+    throw InvalidInput("config: vio.mode must be one of auto, stereo-imu, mono-imu, stereo (got '" +
+                       mode + "')");
+  }
+  try {
+    estimator.validate();
+  } catch (const InvalidInput& e) {
+    // The tracker names its keys from its own section; here they live under vio.tracker.
+    const std::string what = e.what();
+    const std::string prefix = "config: tracker.";
+    if (what.rfind(prefix, 0) == 0) {
+      throw InvalidInput("config: vio.tracker." + what.substr(prefix.size()));
+    }
+    throw;
+  }
+}
+
 void AppConfig::validate() const {
   dataset.validate();
   imu.noise.validate();
+  vio.validate();
   sim.validate();
 }
 
 std::vector<ConfigKey> configKeys(AppConfig& c) {
+  odometry::EstimatorConfig& e = c.vio.estimator;
   return {
       text("dataset.kitti_gnss_source", c.dataset.kitti_gnss_source),
       number("dataset.gap_factor", c.dataset.gap_factor),
@@ -173,6 +193,37 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("imu.gyr_noise_density", c.imu.noise.gyr_noise_density),
       number("imu.acc_random_walk", c.imu.noise.acc_random_walk),
       number("imu.gyr_random_walk", c.imu.noise.gyr_random_walk),
+      text("vio.mode", c.vio.mode),
+      integer("vio.window_size", e.window_size),
+      number("vio.keyframe_parallax_px", e.keyframe_parallax_px),
+      integer("vio.keyframe_min_tracked", e.keyframe_min_tracked),
+      number("vio.pixel_sigma_px", e.pixel_sigma_px),
+      number("vio.huber_sigmas", e.huber_sigmas),
+      integer("vio.max_iterations", e.max_iterations),
+      number("vio.min_depth_m", e.min_depth_m),
+      number("vio.max_depth_m", e.max_depth_m),
+      number("vio.max_reprojection_px", e.max_reprojection_px),
+      number("vio.static_gyr_radps", e.static_gyr_radps),
+      number("vio.static_acc_mps2", e.static_acc_mps2),
+      number("vio.static_pixel_motion_px", e.static_pixel_motion_px),
+      number("vio.init_window_s", e.init_window_s),
+      number("vio.max_imu_gap_s", e.max_imu_gap_s),
+      integer("vio.min_features_tracking", e.min_features_tracking),
+      number("vio.init_tilt_sigma_deg", e.init_tilt_sigma_deg),
+      number("vio.init_velocity_sigma_mps", e.init_velocity_sigma_mps),
+      number("vio.acc_bias_prior_mps2", e.acc_bias_prior_mps2),
+      number("vio.gyr_bias_prior_radps", e.gyr_bias_prior_radps),
+      integer("vio.tracker.max_features", e.tracker.max_features),
+      number("vio.tracker.quality_level", e.tracker.quality_level),
+      integer("vio.tracker.min_distance_px", e.tracker.min_distance_px),
+      integer("vio.tracker.grid_cols", e.tracker.grid_cols),
+      integer("vio.tracker.grid_rows", e.tracker.grid_rows),
+      integer("vio.tracker.klt_window_px", e.tracker.klt_window_px),
+      integer("vio.tracker.klt_levels", e.tracker.klt_levels),
+      integer("vio.tracker.klt_iterations", e.tracker.klt_iterations),
+      number("vio.tracker.fb_threshold_px", e.tracker.fb_threshold_px),
+      number("vio.tracker.ransac_threshold_px", e.tracker.ransac_threshold_px),
+      number("vio.tracker.stereo_max_vertical_px", e.tracker.stereo_max_vertical_px),
       number("sim.origin_lat_deg", c.sim.origin_lat_deg),
       number("sim.origin_lon_deg", c.sim.origin_lon_deg),
       number("sim.origin_h_m", c.sim.origin_h_m),

@@ -10,6 +10,7 @@
 
 #include "io/reader_config.hpp"
 #include "odometry/measurements.hpp"
+#include "odometry/vio_config.hpp"
 #include "sim/sim_config.hpp"
 
 namespace gvio::cli {
@@ -20,9 +21,20 @@ struct ImuConfig {
   ImuNoise noise;
 };
 
+// gvio run's estimator (YAML section `vio:`). The IMU noise comes from `imu:` (or the dataset),
+// the tracker's stereo flag from the mode, so those two fields of `estimator` are set per run.
+struct VioConfig {
+  // auto | stereo-imu | mono-imu | stereo; auto picks from the dataset's sensors at run time.
+  std::string mode = "auto";
+  odometry::EstimatorConfig estimator;
+
+  void validate() const;  // throws InvalidInput naming the key
+};
+
 struct AppConfig {
   io::ReaderConfig dataset;
   ImuConfig imu;
+  VioConfig vio;
   sim::SimConfig sim;
 
   void validate() const;  // throws InvalidInput naming the key

@@ -1,0 +1,135 @@
+// gvio run: visual-inertial odometry over a recorded (or simulated) drive, written as a run folder
+// (trajectory_vio.tum, report.json, config.yaml; DESIGN.md section 4). The pipeline lives in
+// app/run; this file only turns the command line into a run and its outputs into files.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+
+#include "cli/app.hpp"
+#include "io/atomic_write.hpp"
+#include "io/trajectory_io.hpp"
+#include "odometry/error.hpp"
+#include "run/evaluation.hpp"
+#include "run/report.hpp"
+#include "run/stats.hpp"
+#include "run/vio_runner.hpp"
+
+namespace gvio::cli {
+namespace {
+namespace fs = std::filesystem;
+
+struct RunOptions {
+  std::string dataset;
+  std::string format = "auto";
+  std::string gnss = "auto";
+  std::string out = "out/run";
+  ConfigOptions config;
+};
+
+// Checked here rather than by CLI11 so that a bad value is the usual one-line error (exit 2).
+void checkGnssOption(const std::string& gnss) {
+  if (gnss == "kf" || gnss == "graph") {
+    throw InvalidInput("--gnss " + gnss +
+                       ": GNSS fusion is not available in this build (use --gnss auto or off)");
+  }
+  if (gnss != "auto" && gnss != "off") {
+    throw InvalidInput("--gnss '" + gnss + "': expected auto, off, kf or graph");
+  }
+}
+
+void makeOutputDir(const fs::path& out) {
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec || !fs::is_directory(out)) {
+    throw InvalidInput(out.string() + ": cannot create the output folder" +
+                       (ec ? " (" + ec.message() + ")" : std::string()));
+  }
+}
+
+int runRun(const RunOptions& opt, const CommonOptions& common) {
+  checkGnssOption(opt.gnss);
+  const AppConfig config = opt.config.load();
+  const io::Dataset ds =
+      io::readDataset(opt.dataset, io::parseDatasetFormat(opt.format), config.dataset);
+  for (const auto& w : ds.warnings) spdlog::warn("{}", w);
+
+  odometry::EstimatorConfig estimator = config.vio.estimator;
+  estimator.mode = run::chooseVioMode(config.vio.mode, ds);
+  const bool dataset_noise = ds.imu_noise && config.imu.prefer_dataset_noise;
+  estimator.imu_noise = dataset_noise ? *ds.imu_noise : config.imu.noise;
+  estimator.validate();
+  const fs::path out = opt.out;
+  makeOutputDir(out);
+  if (opt.gnss == "auto") {
+    spdlog::info("GNSS fusion is not available in this build: {} fixes are counted, not used",
+                 ds.gnss.size());
+  }
+  spdlog::info("{} {} ({}): {} frames, mode {}", io::toString(ds.format), ds.root.string(),
+               ds.variant, ds.frames.size(), odometry::toString(estimator.mode));
+
+  std::optional<Progress> progress;
+  const run::VioRunResult result =
+      run::runVio(ds, estimator, [&](std::size_t done, std::size_t total) {
+        if (!progress) progress.emplace("vio", total, "frames", common.progressStyle());
+        progress->update(done);
+      });
+  if (progress) progress->finish();
+
+  if (result.trajectory.empty()) {
+    spdlog::warn("the estimator never initialised: trajectory_vio.tum is empty");
+    io::writeTextAtomic(out / "trajectory_vio.tum", "");
+  } else {
+    io::writeTum(out / "trajectory_vio.tum", result.trajectory);
+  }
+  std::optional<run::EvaluationOutcome> evaluation;
+  if (ds.groundtruth && ds.groundtruth->hasTimestamps()) {
+    io::writeTum(out / "groundtruth.tum", *ds.groundtruth);  // for gvio render's error view
+    evaluation = run::evaluateAgainstTruth(*ds.groundtruth, result.trajectory);
+    if (!evaluation->result) spdlog::warn("no evaluation: {}", evaluation->error);
+  }
+  run::ReportContext context;
+  context.command_line = common.command_line;
+  context.gnss_requested = opt.gnss;
+  if (odometry::usesImu(estimator.mode))
+    context.imu_noise_source = dataset_noise ? "dataset" : "config";
+  context.peak_rss_mb = run::peakRssMb();
+  context.evaluation = evaluation ? &*evaluation : nullptr;
+  io::writeTextAtomic(out / "report.json", run::buildReport(ds, result, context).dump(2) + "\n");
+  io::writeTextAtomic(out / "config.yaml", dumpConfigYaml(config));
+
+  const run::TimingSummary total = run::summarizeTimings(result.timings.total_ms);
+  std::string ape = "no ground truth";
+  if (evaluation) {
+    ape = evaluation->result
+              ? fmt::format("APE (SE3) rmse {:.3f} m over {:.0f} m",
+                            evaluation->result->ape_se3.rmse, evaluation->result->path_length_m)
+              : "not evaluated";
+  }
+  spdlog::info(
+      "{} frames, {} keyframes, {} poses written, {}, {:.1f} ms/frame (p95 {:.1f}); wrote {}",
+      result.counters.frames, result.counters.keyframes, result.trajectory.size(), ape, total.mean,
+      total.p95, out.string());
+  return 0;
+}
+
+}  // namespace
+
+Command addRunCommand(CLI::App& app, const CommonOptions& common) {
+  auto opt = std::make_shared<RunOptions>();
+  CLI::App* sub =
+      app.add_subcommand("run", "Visual-inertial odometry over a dataset, written as a run folder");
+  sub->add_option("--dataset", opt->dataset, "Dataset folder (KITTI raw drive, EuRoC)")->required();
+  sub->add_option("--format", opt->format, "Dataset format")
+      ->check(CLI::IsMember({"auto", "kitti-raw", "euroc"}))
+      ->capture_default_str();
+  sub->add_option("--gnss", opt->gnss,
+                  "GNSS use: auto or off (fusion with kf|graph is not in this build; auto = off)")
+      ->capture_default_str();
+  sub->add_option("--out", opt->out, "Run folder (created if missing; files in it are replaced)")
+      ->capture_default_str();
+  opt->config.addTo(*sub);
+  return {sub, [opt, &common] { return runRun(*opt, common); }};
+}
+
+}  // namespace gvio::cli

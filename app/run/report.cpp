@@ -1,0 +1,85 @@
+#include "run/report.hpp"
+
+#include "run/stats.hpp"
+
+namespace gvio::run {
+namespace {
+
+using nlohmann::json;
+
+json timingJson(const std::vector<double>& samples_ms) {
+  const TimingSummary s = summarizeTimings(samples_ms);
+  return {{"mean", s.mean}, {"p95", s.p95}, {"max", s.max}};
+}
+
+double seconds(std::int64_t t_ns) {
+  return static_cast<double>(t_ns) * 1e-9;
+}
+
+json statsJson(const eval::Stats& s) {
+  return {{"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median}, {"std", s.std}, {"min", s.min},
+          {"max", s.max},   {"n", s.n}};
+}
+
+json evaluationJson(const EvaluationOutcome& outcome) {
+  if (!outcome.result) return {{"error", outcome.error}};
+  const RunEvaluation& e = *outcome.result;
+  return {{"ape_se3", statsJson(e.ape_se3)},
+          {"rpe_100m_percent", e.rpe_100m_percent ? json(*e.rpe_100m_percent) : json(nullptr)},
+          {"path_length_m", e.path_length_m}};
+}
+
+}  // namespace
+
+json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportContext& ctx) {
+  json report;
+  report["gvio_version"] = GVIO_VERSION;
+  report["command_line"] = ctx.command_line;
+  report["dataset"] = {
+      {"path", ds.root.string()},
+      {"format", io::toString(ds.format)},
+      {"variant", ds.variant},
+      {"cameras", ds.cameras.size()},
+      {"frames", ds.frames.size()},
+      {"imu_samples", ds.imu.size()},
+      {"imu_rate_hz", imuRateHz(ds)},
+      {"gnss_fixes", ds.gnss.size()},
+      {"groundtruth", ds.groundtruth ? json(ds.groundtruth_source) : json(nullptr)}};
+  report["mode"] = odometry::toString(run.mode);
+  report["imu_noise_source"] =
+      ctx.imu_noise_source.empty() ? json(nullptr) : json(ctx.imu_noise_source);
+  report["rectification"] = {{"identity", run.rectification_identity},
+                             {"baseline_m", run.baseline_m}};
+  const odometry::VioCounters& c = run.counters;
+  report["counts"] = {{"frames", c.frames},
+                      {"keyframes", c.keyframes},
+                      {"initializations", c.initializations},
+                      {"lost_frames", c.lost_frames},
+                      {"coasted_frames", c.coasted_frames},
+                      {"imu_gaps", c.imu_gaps},
+                      {"frames_skipped_unreadable", run.frames_skipped_unreadable},
+                      {"poses_written", run.trajectory.size()},
+                      {"poses_nonfinite", run.nonfinite_poses}};
+  report["timing_ms"] = {{"image_load", timingJson(run.timings.load_ms)},
+                         {"rectify", timingJson(run.timings.rectify_ms)},
+                         {"tracking", timingJson(run.timings.tracking_ms)},
+                         {"estimator", timingJson(run.timings.estimator_ms)},
+                         {"total", timingJson(run.timings.total_ms)}};
+  report["wall_s"] = run.wall_s;
+  report["peak_rss_mb"] = ctx.peak_rss_mb;
+  report["gnss"] = {{"requested", ctx.gnss_requested},
+                    {"mode", "off"},
+                    {"fixes", run.gnss_fixes},
+                    {"used", 0},
+                    {"rejected", 0}};
+  report["outages"] = json::array();
+  json events = json::array();
+  for (const odometry::VioEvent& e : run.events) {
+    events.push_back({{"t", seconds(e.t_ns)}, {"kind", e.kind}, {"message", e.message}});
+  }
+  report["events"] = std::move(events);
+  if (ctx.evaluation) report["evaluation"] = evaluationJson(*ctx.evaluation);
+  return report;
+}
+
+}  // namespace gvio::run

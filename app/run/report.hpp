@@ -1,0 +1,25 @@
+#pragma once
+// report.json of `gvio run` (DESIGN.md section 4): what ran on what, counts, per-frame timings,
+// memory, GNSS use, estimator events and, with ground truth, the evaluation.
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "io/dataset.hpp"
+#include "run/evaluation.hpp"
+#include "run/vio_runner.hpp"
+
+namespace gvio::run {
+
+struct ReportContext {
+  std::string command_line;
+  std::string gnss_requested = "off";  // the --gnss value as given
+  std::string imu_noise_source;        // "dataset" or "config"; empty when the mode has no IMU
+  double peak_rss_mb = 0.0;
+  const EvaluationOutcome* evaluation = nullptr;  // null: the dataset has no ground truth
+};
+
+nlohmann::json buildReport(const io::Dataset& dataset, const VioRunResult& run,
+                           const ReportContext& context);
+
+}  // namespace gvio::run

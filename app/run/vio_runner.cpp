@@ -1,0 +1,175 @@
+#include "run/vio_runner.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <map>
+#include <optional>
+
+#include "io/dataset_summary.hpp"
+#include "io/image_loader.hpp"
+#include "io/input_error.hpp"
+#include "io/measurement_stream.hpp"
+#include "odometry/error.hpp"
+#include "odometry/rectifier.hpp"
+
+namespace gvio::run {
+namespace {
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using odometry::VioMode;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// A real recording may list images that are missing or damaged: each skips its frame. The first
+// one per folder is a warning, the rest are counted, so a long gap does not flood the log.
+class UnreadableImages {
+ public:
+  std::optional<cv::Mat> load(const fs::path& file, const CameraModel& camera) {
+    try {
+      return io::loadGrayImage(file, camera);
+    } catch (const io::InputError& e) {
+      Folder& folder = folders_[file.parent_path()];
+      if (folder.count++ == 0) spdlog::warn("{} (frame skipped)", e.what());
+      return std::nullopt;
+    }
+  }
+  void logSummary() const {
+    for (const auto& [dir, folder] : folders_) {
+      if (folder.count > 1) {
+        spdlog::warn("{}: {} images could not be read, their frames were skipped", dir.string(),
+                     folder.count);
+      }
+    }
+  }
+
+ private:
+  struct Folder {
+    int count = 0;
+  };
+  std::map<fs::path, Folder> folders_;
+};
+
+void appendEvents(odometry::VioEstimator& estimator, std::vector<odometry::VioEvent>& events) {
+  for (auto& e : estimator.takeEvents()) events.push_back(std::move(e));
+}
+
+}  // namespace
+
+double imuRateHz(const io::Dataset& dataset) {
+  std::vector<std::int64_t> stamps;
+  stamps.reserve(dataset.imu.size());
+  for (const ImuSample& s : dataset.imu) stamps.push_back(s.t_ns);
+  return stamps.size() < 2 ? 0.0 : io::streamStats(stamps, 2.0).rate_hz;
+}
+
+VioMode chooseVioMode(const std::string& mode, const io::Dataset& ds) {
+  const std::string where = ds.root.string();
+  const std::size_t cameras = ds.cameras.size();
+  const double rate_hz = imuRateHz(ds);
+  const bool imu = rate_hz >= kMinImuRateHz;
+  if (ds.frames.empty() || cameras == 0) {
+    throw InvalidInput(where + ": no camera frames: gvio run needs a camera");
+  }
+  const std::string imu_text =
+      ds.imu.empty() ? "no IMU" : fmt::format("an IMU at {:.1f} Hz", rate_hz);
+  if (mode == "auto") {
+    if (cameras >= 2) return imu ? VioMode::kStereoImu : VioMode::kStereo;
+    if (imu) return VioMode::kMonoImu;
+    throw InvalidInput(fmt::format(
+        "{}: one camera and {}: no VIO mode fits (mono-imu needs an IMU of >= {:.0f} Hz; a single "
+        "camera alone has no metric scale)",
+        where, imu_text, kMinImuRateHz));
+  }
+  const VioMode chosen = odometry::parseVioMode(mode);
+  if (odometry::usesStereo(chosen) && cameras < 2) {
+    throw InvalidInput(fmt::format(
+        "{}: vio.mode={} needs two cameras, the dataset has one (use vio.mode=mono-imu or auto)",
+        where, mode));
+  }
+  if (odometry::usesImu(chosen) && !imu) {
+    throw InvalidInput(
+        fmt::format("{}: vio.mode={} needs an IMU of >= {:.0f} Hz, the dataset has "
+                    "{} (use vio.mode=stereo or auto)",
+                    where, mode, kMinImuRateHz, imu_text));
+  }
+  return chosen;
+}
+
+VioRunResult runVio(const io::Dataset& ds, odometry::EstimatorConfig config,
+                    const ProgressFn& progress) {
+  const auto start = Clock::now();
+  VioRunResult r;
+  r.mode = config.mode;
+  const bool stereo = odometry::usesStereo(config.mode);
+  if (ds.cameras.empty() || (stereo && ds.cameras.size() < 2)) {
+    throw InvalidInput(ds.root.string() + ": not enough cameras for " + toString(config.mode));
+  }
+  const odometry::Rectifier rectifier(
+      ds.cameras[0], stereo ? std::optional<CameraModel>(ds.cameras[1]) : std::nullopt);
+  r.rectification_identity = rectifier.isIdentity();
+  r.baseline_m = rectifier.baselineM();
+  config.tracker.stereo = stereo;
+  odometry::VioEstimator estimator(config, rectifier.left(), rectifier.right());
+
+  UnreadableImages unreadable;
+  io::MeasurementStream stream(ds);
+  std::size_t frames_done = 0;
+  while (const auto m = stream.next()) {
+    if (const auto* imu = std::get_if<const ImuSample*>(&*m)) {
+      estimator.addImu(**imu);
+      ++r.imu_samples;
+      continue;
+    }
+    if (std::holds_alternative<const GnssFix*>(*m)) {
+      ++r.gnss_fixes;  // counted only: GNSS fusion is not part of this build
+      continue;
+    }
+    const io::FrameRecord& frame = *std::get<const io::FrameRecord*>(*m);
+    if (progress) progress(frames_done, ds.frames.size());
+    ++frames_done;
+    const auto t_frame = Clock::now();
+    std::optional<cv::Mat> left = unreadable.load(frame.image_paths[0], ds.cameras[0]);
+    std::optional<cv::Mat> right;
+    if (left && stereo) right = unreadable.load(frame.image_paths[1], ds.cameras[1]);
+    if (!left || (stereo && !right)) {
+      ++r.frames_skipped_unreadable;  // the estimator sees a gap, as after a dropped frame
+      continue;
+    }
+    const double load_ms = msSince(t_frame);
+    const auto t_rectify = Clock::now();
+    const odometry::RectifiedImages images = rectifier.rectify(*left, right ? *right : cv::Mat());
+    const double rectify_ms = msSince(t_rectify);
+    const odometry::FrameResult result = estimator.addFrame(frame.t_ns, images.left, images.right);
+    r.timings.load_ms.push_back(load_ms);
+    r.timings.rectify_ms.push_back(rectify_ms);
+    r.timings.tracking_ms.push_back(result.ms_tracking);
+    r.timings.estimator_ms.push_back(result.ms_estimator);
+    r.timings.total_ms.push_back(msSince(t_frame));
+    appendEvents(estimator, r.events);
+    if (!result.initialized) continue;
+    // Never write NaN; a stamp that does not increase would break TUM readers' association.
+    if (!result.T_w_b.matrix().allFinite()) {
+      ++r.nonfinite_poses;
+      continue;
+    }
+    if (!r.trajectory.t_ns.empty() && frame.t_ns <= r.trajectory.t_ns.back()) continue;
+    r.trajectory.t_ns.push_back(frame.t_ns);
+    r.trajectory.poses.push_back(result.T_w_b);
+  }
+  if (progress) progress(frames_done, ds.frames.size());
+  appendEvents(estimator, r.events);
+  unreadable.logSummary();
+  if (r.nonfinite_poses > 0) {
+    spdlog::warn("{} initialised frames had a non-finite pose and were left out of the trajectory",
+                 r.nonfinite_poses);
+  }
+  r.counters = estimator.counters();
+  r.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return r;
+}
+
+}  // namespace gvio::run

@@ -1,0 +1,56 @@
+#pragma once
+// gvio run's pipeline: the dataset's measurements in time order through the rectifier and the VIO
+// estimator (IMU -> addImu, frames -> load, rectify, addFrame; GNSS only counted until fusion
+// lands), collecting the trajectory, counters, events and per-frame timings for report.json.
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "io/dataset.hpp"
+#include "odometry/trajectory.hpp"
+#include "odometry/vio_config.hpp"
+#include "odometry/vio_estimator.hpp"
+
+namespace gvio::run {
+
+// An IMU slower than this is no IMU for VIO (KITTI sync drives: 10 Hz oxts).
+inline constexpr double kMinImuRateHz = 50.0;
+
+// 1 / median sample period of the dataset's IMU, 0 with fewer than two samples.
+double imuRateHz(const io::Dataset& dataset);
+
+// The sensor set for `mode` (config text: auto | stereo-imu | mono-imu | stereo). auto: stereo-imu
+// with two cameras and an IMU of >= kMinImuRateHz, stereo with two cameras and no such IMU,
+// mono-imu with one camera and such an IMU. Throws InvalidInput naming the dataset when it lacks
+// what the mode needs.
+odometry::VioMode chooseVioMode(const std::string& mode, const io::Dataset& dataset);
+
+// Wall-clock milliseconds per processed frame, one entry per stage.
+struct FrameTimings {
+  std::vector<double> load_ms, rectify_ms, tracking_ms, estimator_ms, total_ms;
+};
+
+struct VioRunResult {
+  odometry::VioMode mode = odometry::VioMode::kStereoImu;
+  bool rectification_identity = true;  // the cameras were already rectified
+  double baseline_m = 0.0;             // rectified stereo baseline, 0 in mono
+  Trajectory trajectory;               // T_w_b (VIO world) of every initialised frame
+  odometry::VioCounters counters;
+  int frames_skipped_unreadable = 0;  // an image failed to load: the frame never reached the VIO
+  int nonfinite_poses = 0;            // initialised frames whose pose was not finite (not written)
+  std::size_t imu_samples = 0, gnss_fixes = 0;
+  std::vector<odometry::VioEvent> events;
+  FrameTimings timings;
+  double wall_s = 0.0;
+};
+
+using ProgressFn = std::function<void(std::size_t frames_done, std::size_t frames_total)>;
+
+// `config.mode` and `config.imu_noise` are the run's (chooseVioMode, dataset or imu.* noise); the
+// tracker's stereo flag is set here from the mode. Throws InvalidInput for cameras the rectifier
+// or estimator refuse; unreadable images only skip their frame (logged once per folder).
+VioRunResult runVio(const io::Dataset& dataset, odometry::EstimatorConfig config,
+                    const ProgressFn& progress = {});
+
+}  // namespace gvio::run
