@@ -51,6 +51,7 @@ case "$mode" in
     mkdir -p out/demo
     "$BUILD_DIR/app/gvio" simulate --trajectory assets/demo/drive.tum --seconds 20 --out out/demo/drive --force
     "$BUILD_DIR/app/gvio" inspect --dataset out/demo/drive --json out/demo/inspect.json
+    mkdir -p out/demo/run/render
     "$BUILD_DIR/app/gvio" run --dataset out/demo/drive --gnss off --out out/demo/run
     "$BUILD_DIR/app/gvio" render --run out/demo/run --view error --out out/demo/run/render/error.png
     echo "setup: demo drive in out/demo/drive, VIO run (trajectory_vio.tum, report.json) in out/demo/run"

@@ -30,7 +30,8 @@ void WindowFrame::setBias(const ImuBias& b) {
 SlidingWindow::SlidingWindow(const EstimatorConfig& config, const StereoGeometry& geometry)
     : config_(config),
       geometry_(geometry),
-      huber_(std::make_shared<ceres::HuberLoss>(config.huber_sigmas)) {}
+      huber_(std::make_shared<ceres::HuberLoss>(config.huber_sigmas)),
+      context_(ceres::Context::Create()) {}
 
 WindowFrame* SlidingWindow::find(std::uint64_t uid) const {
   for (const auto& f : frames_) {
@@ -112,6 +113,7 @@ SolveStats SlidingWindow::solve(bool use_imu) {
   popts.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   popts.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   popts.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  popts.context = context_.get();
   ceres::Problem problem(popts);
   std::vector<std::shared_ptr<ceres::CostFunction>> alive;  // the problem does not own them
   const auto add = [&](std::shared_ptr<ceres::CostFunction> cost, const ceres::LossFunction* loss,

@@ -2,6 +2,7 @@
 // The estimator's sliding window: frame states (pose, velocity and biases) at stable addresses,
 // the landmarks, the marginalisation prior, and the two operations on them: one Ceres solve of
 // reprojection + IMU + prior residuals, and the marginalisation of the oldest keyframe.
+#include <ceres/context.h>
 #include <ceres/loss_function.h>
 #include <array>
 #include <cstdint>
@@ -97,6 +98,8 @@ class SlidingWindow {
   StereoGeometry geometry_;
   PoseManifold pose_manifold_;
   std::shared_ptr<ceres::LossFunction> huber_;
+  // One Ceres context for every solve (its set-up is not free at 10 solves per second).
+  std::shared_ptr<ceres::Context> context_;
   std::deque<std::unique_ptr<WindowFrame>> frames_;
   LandmarkMap landmarks_;
   std::shared_ptr<const MarginalizationPrior> prior_;

@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# End-to-end VIO benchmark (issue 6): simulates the full KITTI-00 drive once (cached), runs
+# `gvio run --gnss off` in each mode, evaluates with `gvio eval` (SE(3) alignment: APE RMSE and RPE
+# per 100 m) and prints a table with ms/frame per stage (mean, p95) and peak RSS from report.json.
+# A benchmark, not a test: nothing here asserts a timing.
+#
+#   tests/bench/vio_kitti00.sh                         # all modes, full drive
+#   BENCH_MODES="stereo-imu" BENCH_SECONDS=60 tests/bench/vio_kitti00.sh
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+BUILD_DIR="${BUILD_DIR:-build}"
+GVIO="$BUILD_DIR/app/gvio"
+DATA="${GVIO_SHARED_DATA:-../shared/data}/kitti00"
+MODES="${BENCH_MODES:-stereo-imu stereo mono-imu}"
+SECONDS_ARG=()
+TAG="full"
+if [ -n "${BENCH_SECONDS:-}" ]; then
+  SECONDS_ARG=(--seconds "$BENCH_SECONDS")
+  TAG="${BENCH_SECONDS}s"
+fi
+if [ ! -f "$DATA/KITTI_00_gt.txt" ]; then
+  echo "bench: $DATA/KITTI_00_gt.txt absent: nothing to benchmark" >&2
+  exit 0
+fi
+[ -x "$GVIO" ] || { echo "bench: $GVIO not built (./setup.sh build)" >&2; exit 2; }
+
+CACHE="${GVIO_BENCH_CACHE:-$BUILD_DIR/bench_cache}/kitti00_${TAG}_seed1"
+if [ ! -f "$CACHE/sim.yaml" ]; then
+  echo "bench: simulating KITTI-00 ($TAG) into $CACHE (once; about 12 min for the full drive)" >&2
+  rm -rf "$CACHE.partial"
+  "$GVIO" simulate --trajectory "$DATA/KITTI_00_gt.txt" --times "$DATA/KITTI_00_gt_times.txt" \
+    --gnss-noise spp --seed 1 "${SECONDS_ARG[@]}" --out "$CACHE.partial" --force --no-progress
+  rm -rf "$CACHE"
+  mv "$CACHE.partial" "$CACHE"
+fi
+
+OUT="${BENCH_OUT:-out/bench/vio_kitti00_$TAG}"
+mkdir -p "$OUT"
+for mode in $MODES; do
+  run="$OUT/$mode"
+  "$GVIO" run --dataset "$CACHE" --gnss off --set "vio.mode=$mode" --out "$run" --no-progress
+  if [ -s "$run/trajectory_vio.tum" ]; then
+    "$GVIO" eval --ref "$CACHE/groundtruth.tum" --est "$run/trajectory_vio.tum" --align se3 \
+      --rpe-delta 100 --rpe-unit m --json "$run/eval.json" > /dev/null
+  fi
+done
+
+python3 - "$OUT" $MODES <<'PY'
+import json, os, sys
+out, modes = sys.argv[1], sys.argv[2:]
+print("| mode | poses | APE RMSE (m) | RPE per 100 m (mean %, rmse %) | tracking ms mean / p95 "
+      "| estimator ms mean / p95 | tracking + estimator mean (ms) | peak RSS (MB) |")
+print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+for mode in modes:
+    rep = json.load(open(os.path.join(out, mode, "report.json")))
+    t = rep["timing_ms"]
+    ev_path = os.path.join(out, mode, "eval.json")
+    if os.path.exists(ev_path):
+        ev = json.load(open(ev_path))
+        ape = f'{ev["ape"]["rmse"]:.3f}'
+        rpe = f'{ev["rpe"]["mean"]:.3f}, {ev["rpe"]["rmse"]:.3f}' if "rpe" in ev else "n/a"
+    else:
+        ape = rpe = "no poses"
+    front_back = t["tracking"]["mean"] + t["estimator"]["mean"]
+    print(f'| {mode} | {rep["counts"]["poses_written"]}/{rep["counts"]["frames"]} | {ape} | {rpe} '
+          f'| {t["tracking"]["mean"]:.1f} / {t["tracking"]["p95"]:.1f} '
+          f'| {t["estimator"]["mean"]:.1f} / {t["estimator"]["p95"]:.1f} | {front_back:.1f} '
+          f'| {rep["peak_rss_mb"]:.0f} |')
+PY
