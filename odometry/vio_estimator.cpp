@@ -24,9 +24,20 @@ constexpr double kTimeJumpS = 1.0;
 constexpr double kMaxCoastS = 2.0;
 // A keyframe at least this often bounds the preintegration length (and a standing vehicle).
 constexpr double kMaxKeyframeIntervalS = 1.0;
+// A car-like platform does not move faster than this between frames, nor turn faster: an
+// estimate that does is a failed solve (a wrong PnP or a local minimum), not motion.
+constexpr double kMaxSpeedMps = 70.0;
+constexpr double kMaxTurnRateRadps = 2.0;
 // solvePnPRansac for the visual pose prediction.
 constexpr int kMinPnpPoints = 8;
 constexpr float kPnpReprojectionPx = 3.0F;
+
+bool plausibleMotion(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to, double dt_s) {
+  const double dt = std::max(dt_s, 0.01);
+  const double angle = Eigen::AngleAxisd(from.rotation().transpose() * to.rotation()).angle();
+  return (to.translation() - from.translation()).norm() <= kMaxSpeedMps * dt + 0.5 &&
+         angle <= kMaxTurnRateRadps * dt + 0.05;
+}
 
 PinholeView viewOf(const CameraModel& cam) {
   PinholeView v;
@@ -107,6 +118,7 @@ bool VioEstimator::Impl::checkTime(std::int64_t t_ns) {
               "time jump of " + std::to_string(static_cast<double>(dt) * 1e-9) +
                   " s: restarting the window",
               false);
+      previous_pose.reset();  // the old velocity says nothing about the motion after the jump
     } else if (nominal_frame_ns > 0 && dt > nominal_frame_ns * 3 / 2) {
       event(t_ns, "dropped_frame",
             std::to_string(dt / nominal_frame_ns - 1) + " frame(s) missing before this one");
@@ -123,7 +135,6 @@ void VioEstimator::Impl::restart(std::int64_t t_ns, const std::string& kind, con
   tracker.reset();
   if (!keep_imu_alignment) imu_aligned = false;
   coast_start_ns = -1;
-  previous_pose.reset();
   if (keep_imu_alignment && latest.valid) ++counters.initializations;
 }
 
@@ -180,6 +191,7 @@ std::optional<Eigen::Isometry3d> VioEstimator::Impl::predictVisual(
     image.emplace_back(f.px_left.x(), f.px_left.y());
   }
   if (object.size() < static_cast<std::size_t>(kMinPnpPoints) || !latest.valid) return std::nullopt;
+  const double guess_dt_s = static_cast<double>(tracked.t_ns - latest.t_ns) * 1e-9;
   // Initial guess: constant velocity from the last two estimates.
   Eigen::Isometry3d guess = latest.T_w_b;
   if (previous_pose) guess = latest.T_w_b * (previous_pose->inverse() * latest.T_w_b);
@@ -195,14 +207,19 @@ std::optional<Eigen::Isometry3d> VioEstimator::Impl::predictVisual(
   std::vector<int> inliers;
   const bool ok = cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, true, 100,
                                      kPnpReprojectionPx, 0.99, inliers, cv::SOLVEPNP_ITERATIVE);
-  if (!ok || inliers.size() < static_cast<std::size_t>(kMinPnpPoints)) return guess;
+  // A minority of inliers means RANSAC may have locked onto a wrong model: keep the guess.
+  if (!ok || inliers.size() < static_cast<std::size_t>(kMinPnpPoints) ||
+      2 * inliers.size() < object.size()) {
+    return guess;
+  }
   cv::Rodrigues(rvec, R_cv);
   Eigen::Isometry3d T_c_w_new = Eigen::Isometry3d::Identity();
   for (int r = 0; r < 3; ++r) {
     T_c_w_new.translation()(r) = tvec.at<double>(r);
     for (int c = 0; c < 3; ++c) T_c_w_new.linear()(r, c) = R_cv.at<double>(r, c);
   }
-  return T_c_w_new.inverse() * geometry.left.T_b_c.inverse();
+  const Eigen::Isometry3d pnp = T_c_w_new.inverse() * geometry.left.T_b_c.inverse();
+  return plausibleMotion(latest.T_w_b, pnp, guess_dt_s) ? pnp : guess;
 }
 
 std::unique_ptr<WindowFrame> VioEstimator::Impl::predictFrame(std::int64_t t_ns,
@@ -327,6 +344,13 @@ FrameResult VioEstimator::Impl::process(std::int64_t t_ns, const TrackedFrame& t
     window.solve(true);
   }
 
+  if (latest.valid && (!usesImu(config.mode) || imu_aligned) &&
+      !plausibleMotion(latest.T_w_b, f.T_w_b(), static_cast<double>(t_ns - latest.t_ns) * 1e-9)) {
+    // Never hand out a jump: drop the frame's solve and go on from the latest estimate.
+    window.dropNewest();
+    restart(t_ns, "lost", "implausible motion estimate: restarting the window", imuActive());
+    return coast(t_ns, "implausible motion estimate");
+  }
   FrameResult r;
   r.t_ns = t_ns;
   r.initialized = !usesImu(config.mode) || imu_aligned;
