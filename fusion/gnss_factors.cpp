@@ -1,0 +1,71 @@
+#include "fusion/gnss_factors.hpp"
+
+#include "odometry/lie.hpp"
+#include "odometry/pose_manifold.hpp"
+
+namespace gvio::fusion {
+namespace {
+
+using odometry::hat;
+using odometry::poseMinusJacobian;
+using odometry::poseP;
+using odometry::poseQ;
+
+}  // namespace
+
+RelativePoseFactor::RelativePoseFactor(const Eigen::Isometry3d& T_i_j, double sigma_rot_rad,
+                                       double sigma_pos_m)
+    : dR_(T_i_j.rotation()),
+      dp_(T_i_j.translation()),
+      inv_sigma_rot_(1.0 / sigma_rot_rad),
+      inv_sigma_pos_(1.0 / sigma_pos_m) {}
+
+bool RelativePoseFactor::Evaluate(double const* const* parameters, double* residuals,
+                                  double** jacobians) const {
+  const Eigen::Matrix3d R_i = poseQ(parameters[0]).normalized().toRotationMatrix();
+  const Eigen::Matrix3d R_j = poseQ(parameters[1]).normalized().toRotationMatrix();
+  const Eigen::Vector3d a = R_i.transpose() * (poseP(parameters[1]) - poseP(parameters[0]));
+  const Eigen::Vector3d r_rot = odometry::logSo3(dR_.transpose() * R_i.transpose() * R_j);
+  Eigen::Map<Eigen::Matrix<double, 6, 1>> r(residuals);
+  r << inv_sigma_rot_ * r_rot, inv_sigma_pos_ * (a - dp_);
+  if (jacobians == nullptr) return true;
+  const Eigen::Matrix3d Jr_inv = odometry::rightJacobianInverseSo3(r_rot);
+  using Jac6x7 = Eigen::Matrix<double, 6, 7, Eigen::RowMajor>;
+  if (jacobians[0] != nullptr) {
+    // d r_rot / d dphi_i = -Jr^-1 R_j^T R_i; d a / d dphi_i = hat(a); d a / d dp_i = -I.
+    Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
+    J.topLeftCorner<3, 3>() = -inv_sigma_rot_ * Jr_inv * R_j.transpose() * R_i;
+    J.bottomLeftCorner<3, 3>() = inv_sigma_pos_ * hat(a);
+    J.bottomRightCorner<3, 3>() = -inv_sigma_pos_ * Eigen::Matrix3d::Identity();
+    Eigen::Map<Jac6x7>{jacobians[0]} = J * poseMinusJacobian(parameters[0]);
+  }
+  if (jacobians[1] != nullptr) {
+    // d r_rot / d dphi_j = Jr^-1; d a / d dp_j = R_i^T R_j.
+    Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
+    J.topLeftCorner<3, 3>() = inv_sigma_rot_ * Jr_inv;
+    J.bottomRightCorner<3, 3>() = inv_sigma_pos_ * R_i.transpose() * R_j;
+    Eigen::Map<Jac6x7>{jacobians[1]} = J * poseMinusJacobian(parameters[1]);
+  }
+  return true;
+}
+
+GnssPositionFactor::GnssPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix,
+                                       double sigma_h_m, double sigma_v_m)
+    : q_b_(q_b), p_fix_(p_enu_fix), inv_sigma_(1.0 / sigma_h_m, 1.0 / sigma_h_m, 1.0 / sigma_v_m) {}
+
+bool GnssPositionFactor::Evaluate(double const* const* parameters, double* residuals,
+                                  double** jacobians) const {
+  const Eigen::Matrix3d R = poseQ(parameters[0]).normalized().toRotationMatrix();
+  Eigen::Map<Eigen::Vector3d>{residuals} =
+      inv_sigma_.asDiagonal() * (poseP(parameters[0]) + R * q_b_ - p_fix_);
+  if (jacobians != nullptr && jacobians[0] != nullptr) {
+    // d (R Exp(dphi) q) / d dphi = -R hat(q); d (p + R dp) / d dp = R.
+    Eigen::Matrix<double, 3, 6> J;
+    J << inv_sigma_.asDiagonal() * (-R * hat(q_b_)), inv_sigma_.asDiagonal() * R;
+    Eigen::Map<Eigen::Matrix<double, 3, 7, Eigen::RowMajor>>{jacobians[0]} =
+        J * poseMinusJacobian(parameters[0]);
+  }
+  return true;
+}
+
+}  // namespace gvio::fusion

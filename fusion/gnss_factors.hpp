@@ -1,0 +1,41 @@
+#pragma once
+// Factors of the global GNSS fusion graph (fusion/graph_fusion.hpp). Nodes are body poses in ENU on
+// odometry::PoseManifold (tangent (dphi, dp), perturbation (R Exp(dphi), p + R dp)); analytic
+// Jacobians are handed to Ceres as J_tangent * MinusJacobian(x), as the estimator's factors do.
+#include <ceres/sized_cost_function.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace gvio::fusion {
+
+// VIO relative motion between two nodes, T_i^-1 T_j = dT (measured), whitened per axis:
+//   r = (Log(dR^T R_i^T R_j) / sigma_rot, (R_i^T (p_j - p_i) - dp) / sigma_pos).
+class RelativePoseFactor final : public ceres::SizedCostFunction<6, 7, 7> {
+ public:
+  RelativePoseFactor(const Eigen::Isometry3d& T_i_j, double sigma_rot_rad, double sigma_pos_m);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  Eigen::Matrix3d dR_;
+  Eigen::Vector3d dp_;
+  double inv_sigma_rot_, inv_sigma_pos_;
+};
+
+// A GNSS fix of the antenna on node i: the antenna sits at q_b in the node's body frame (the lever
+// arm carried by the VIO motion from the node's time to the fix time), so
+//   r = diag(1/sigma_h, 1/sigma_h, 1/sigma_v) (p_i + R_i q_b - p_enu_fix).
+class GnssPositionFactor final : public ceres::SizedCostFunction<3, 7> {
+ public:
+  GnssPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix, double sigma_h_m,
+                     double sigma_v_m);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  Eigen::Vector3d q_b_, p_fix_;
+  Eigen::Vector3d inv_sigma_;
+};
+
+}  // namespace gvio::fusion

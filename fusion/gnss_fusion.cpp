@@ -1,0 +1,290 @@
+#include "fusion/gnss_fusion.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "fusion/gnss_factors.hpp"
+#include "fusion/graph_window.hpp"
+#include "odometry/error.hpp"
+
+namespace gvio::fusion {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+// Chi-square, 6 degrees of freedom, 99.9 %: the KF's position + velocity innovation gate.
+constexpr double kKfGateChi2 = 22.46;
+// Solver iterations per fix in graph mode (the window is small and warm-started).
+constexpr int kGraphIterations = 5;
+// A fix without a usable previous one gets no velocity information (variance in (m/s)^2).
+constexpr double kNoVelocityVariance = 1e8;
+
+}  // namespace
+
+std::string toString(FusionMode mode) {
+  return mode == FusionMode::kKf ? "kf" : "graph";
+}
+
+FusionMode parseFusionMode(const std::string& name) {
+  if (name == "kf") return FusionMode::kKf;
+  if (name == "graph") return FusionMode::kGraph;
+  throw InvalidInput("fusion mode must be kf or graph (got '" + name + "')");
+}
+
+void FusionConfig::validate() const {
+  const auto positive = [](double v, const char* name) {
+    if (!(std::isfinite(v) && v > 0.0)) {
+      throw InvalidInput(std::string("config: fusion.") + name + " must be > 0");
+    }
+  };
+  if (!lever_arm_b.allFinite()) throw InvalidInput("config: fusion.lever_arm_b must be finite");
+  if (!std::isfinite(receiver_time_offset_s)) {
+    throw InvalidInput("config: fusion.receiver_time_offset_s must be finite");
+  }
+  if (alignment_min_fixes < 3)
+    throw InvalidInput("config: fusion.alignment_min_fixes must be >= 3");
+  if (window_nodes < 2) throw InvalidInput("config: fusion.window_nodes must be >= 2");
+  if (max_consecutive_rejections < 1) {
+    throw InvalidInput("config: fusion.max_consecutive_rejections must be >= 1");
+  }
+  positive(alignment_min_extent_m, "alignment_min_extent_m");
+  positive(vio_drift_fraction, "vio_drift_fraction");
+  positive(vio_sigma_floor_m, "vio_sigma_floor_m");
+  positive(vio_rot_drift_rad_per_m, "vio_rot_drift_rad_per_m");
+  positive(vio_rot_floor_rad, "vio_rot_floor_rad");
+  positive(huber_sigmas, "huber_sigmas");
+  positive(gate_chi2, "gate_chi2");
+  positive(outage_s, "outage_s");
+  kf.validate();
+}
+
+struct GnssFusion::Impl {
+  struct Pair {
+    std::int64_t t_ns;
+    Eigen::Isometry3d T_w_b;
+    Eigen::Vector3d p_enu;
+    GnssFix fix;
+  };
+
+  Impl(const FusionConfig& c, const EnuFrame& e)
+      : config(c), enu(e), graph(c.window_nodes, c.huber_sigmas, kGraphIterations), kf(c.kf) {}
+
+  void processFix(const GnssFix& fix);
+  void align(const Pair& pair);
+  bool fuseGraph(const Pair& pair);
+  bool fuseKf(const Pair& pair);
+  Eigen::Isometry3d fusedPose(std::int64_t t_ns, const Eigen::Isometry3d& T_w_b) const;
+  void noteAccepted(std::int64_t t_ns);
+
+  FusionConfig config;
+  EnuFrame enu;
+  Trajectory vio, fused;
+  std::deque<GnssFix> pending;
+  std::vector<Pair> alignment_pairs;
+  std::optional<Eigen::Isometry3d> T_enu_w;
+  GraphWindow graph;
+  KfBaseline kf;
+  std::int64_t kf_t_ns = 0;
+  std::optional<Pair> previous_fix;  // KF: finite-difference GNSS velocity
+  int consecutive_rejections = 0;
+  std::optional<std::int64_t> last_accepted_ns;
+  FusionStats stats;
+};
+
+Eigen::Isometry3d GnssFusion::Impl::fusedPose(std::int64_t t_ns,
+                                              const Eigen::Isometry3d& T_w_b) const {
+  if (config.mode == FusionMode::kGraph && !graph.empty()) {
+    const GraphNode& n = graph.newest();
+    return n.T_enu_b() * n.T_w_b.inverse() * T_w_b;  // the newest node carried by the VIO motion
+  }
+  Eigen::Isometry3d T = *T_enu_w * T_w_b;
+  if (config.mode == FusionMode::kKf) {
+    const double dt = static_cast<double>(t_ns - kf_t_ns) * 1e-9;
+    T.translation() += kf.state().head<3>() + kf.state().tail<3>() * std::max(dt, 0.0);
+  }
+  return T;
+}
+
+void GnssFusion::Impl::noteAccepted(std::int64_t t_ns) {
+  if (last_accepted_ns && static_cast<double>(t_ns - *last_accepted_ns) * 1e-9 > config.outage_s) {
+    stats.outages.emplace_back(*last_accepted_ns, t_ns);
+  }
+  last_accepted_ns = t_ns;
+  ++stats.fixes_used;
+  consecutive_rejections = 0;
+}
+
+void GnssFusion::Impl::align(const Pair& pair) {
+  alignment_pairs.push_back(pair);
+  if (static_cast<int>(alignment_pairs.size()) < config.alignment_min_fixes) return;
+  std::vector<Eigen::Vector3d> p_w, p_enu;
+  for (const Pair& p : alignment_pairs) {
+    p_w.push_back(p.T_w_b * config.lever_arm_b);
+    p_enu.push_back(p.p_enu);
+  }
+  T_enu_w = alignVioToEnu(p_w, p_enu, config.alignment, config.alignment_min_extent_m);
+  if (!T_enu_w) return;
+  // Back-fill the poses seen so far with the registration, then start the chosen filter.
+  stats.poses_before_alignment = static_cast<int>(vio.size());
+  fused.t_ns = vio.t_ns;
+  fused.poses.clear();
+  for (const auto& T : vio.poses) fused.poses.push_back(*T_enu_w * T);
+  for (const Pair& p : alignment_pairs) {
+    const bool used = config.mode == FusionMode::kGraph ? fuseGraph(p) : fuseKf(p);
+    if (used) {
+      noteAccepted(p.t_ns);
+    } else {
+      ++stats.fixes_rejected;
+    }
+  }
+  alignment_pairs.clear();
+}
+
+bool GnssFusion::Impl::fuseGraph(const Pair& pair) {
+  const Eigen::Vector3d& lever = config.lever_arm_b;
+  if (graph.empty()) {
+    GraphNode& n = graph.addNode(pair.t_ns, *T_enu_w * pair.T_w_b, pair.T_w_b, nullptr);
+    graph.addGnssFactor(n, std::make_shared<GnssPositionFactor>(
+                               lever, pair.p_enu, pair.fix.sigma_h_m, pair.fix.sigma_v_m));
+    graph.solve();
+    return true;
+  }
+  const GraphNode& last = graph.newest();
+  const Eigen::Isometry3d T_rel = last.T_w_b.inverse() * pair.T_w_b;
+  const Eigen::Isometry3d T_pred = last.T_enu_b() * T_rel;
+  const double dist = T_rel.translation().norm();
+  // Gate: the fix against the antenna predicted by the VIO motion since the newest node. The node
+  // is itself uncertain by up to about one fix's sigma (it rests on a few fixes seen through the
+  // VIO), hence twice the fix variance plus the VIO drift since the node.
+  const double sigma_pred = config.vio_drift_fraction * dist + config.vio_sigma_floor_m;
+  const Eigen::Vector3d innovation = pair.p_enu - T_pred * lever;
+  const double var_h = 2.0 * pair.fix.sigma_h_m * pair.fix.sigma_h_m + sigma_pred * sigma_pred;
+  const Eigen::Vector3d variance(
+      var_h, var_h, 2.0 * pair.fix.sigma_v_m * pair.fix.sigma_v_m + sigma_pred * sigma_pred);
+  const double chi2 = innovation.cwiseAbs2().cwiseQuotient(variance).sum();
+  if (chi2 > config.gate_chi2 && consecutive_rejections < config.max_consecutive_rejections) {
+    return false;
+  }
+  auto relative = std::make_shared<RelativePoseFactor>(
+      T_rel, config.vio_rot_drift_rad_per_m * dist + config.vio_rot_floor_rad,
+      config.vio_drift_fraction * dist + config.vio_sigma_floor_m);
+  GraphNode& n = graph.addNode(pair.t_ns, T_pred, pair.T_w_b, relative);
+  graph.addGnssFactor(n, std::make_shared<GnssPositionFactor>(lever, pair.p_enu, pair.fix.sigma_h_m,
+                                                              pair.fix.sigma_v_m));
+  graph.solve();
+  return true;
+}
+
+bool GnssFusion::Impl::fuseKf(const Pair& pair) {
+  const Eigen::Vector3d& lever = config.lever_arm_b;
+  const Eigen::Vector3d p_vio = *T_enu_w * (pair.T_w_b * lever);
+  kf.predict(pair.t_ns);
+  KfBaseline::Vector6d z;
+  KfBaseline::Matrix6d R = KfBaseline::Matrix6d::Zero();
+  const Eigen::Vector3d var_p(pair.fix.sigma_h_m * pair.fix.sigma_h_m,
+                              pair.fix.sigma_h_m * pair.fix.sigma_h_m,
+                              pair.fix.sigma_v_m * pair.fix.sigma_v_m);
+  z.head<3>() = pair.p_enu - p_vio;
+  R.diagonal().head<3>() = var_p;
+  // No Doppler in the input: GNSS velocity by finite differences of consecutive fixes, against the
+  // VIO's over the same interval (the reference method's fallback).
+  z.tail<3>().setZero();
+  R.diagonal().tail<3>().setConstant(kNoVelocityVariance);
+  if (previous_fix) {
+    const double dt = static_cast<double>(pair.t_ns - previous_fix->t_ns) * 1e-9;
+    if (dt > 0.0) {
+      const Eigen::Vector3d p_vio_prev = *T_enu_w * (previous_fix->T_w_b * lever);
+      z.tail<3>() = (pair.p_enu - previous_fix->p_enu) / dt - (p_vio - p_vio_prev) / dt;
+      const GnssFix& prev = previous_fix->fix;
+      const Eigen::Vector3d var_prev(prev.sigma_h_m * prev.sigma_h_m,
+                                     prev.sigma_h_m * prev.sigma_h_m,
+                                     prev.sigma_v_m * prev.sigma_v_m);
+      R.diagonal().tail<3>() = (var_p + var_prev) / (dt * dt);
+    }
+  }
+  previous_fix = pair;
+  KfBaseline candidate = kf;
+  const double nis = candidate.update(z, R);
+  if (nis > kKfGateChi2 && consecutive_rejections < config.max_consecutive_rejections &&
+      stats.fixes_used > 0) {
+    return false;
+  }
+  kf = candidate;
+  kf_t_ns = pair.t_ns;
+  return true;
+}
+
+void GnssFusion::Impl::processFix(const GnssFix& fix) {
+  const auto start = Clock::now();
+  const auto T_w_b = interpolatePose(vio, fix.t_ns);
+  if (!T_w_b) {
+    ++stats.fixes_unmatched;
+    return;
+  }
+  Pair pair{fix.t_ns, *T_w_b, enu.toEnu({fix.lat_deg, fix.lon_deg, fix.h_ellipsoid_m}), fix};
+  if (!T_enu_w) {
+    align(pair);
+  } else {
+    const bool used = config.mode == FusionMode::kGraph ? fuseGraph(pair) : fuseKf(pair);
+    if (used) {
+      noteAccepted(pair.t_ns);
+    } else {
+      ++stats.fixes_rejected;
+      ++consecutive_rejections;
+    }
+  }
+  stats.ms_per_fix.push_back(
+      std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+}
+
+GnssFusion::GnssFusion(const FusionConfig& config, const EnuFrame& enu) {
+  config.validate();
+  impl_ = std::make_unique<Impl>(config, enu);
+}
+GnssFusion::~GnssFusion() = default;
+
+void GnssFusion::addVioPose(std::int64_t t_ns, const Eigen::Isometry3d& T_w_b) {
+  Impl& s = *impl_;
+  if (!s.vio.t_ns.empty() && t_ns <= s.vio.t_ns.back()) return;
+  s.vio.t_ns.push_back(t_ns);
+  s.vio.poses.push_back(T_w_b);
+  while (!s.pending.empty() && s.pending.front().t_ns <= t_ns) {
+    const GnssFix fix = s.pending.front();
+    s.pending.pop_front();
+    s.processFix(fix);
+  }
+  if (s.T_enu_w && s.fused.size() < s.vio.size()) {
+    s.fused.t_ns.push_back(t_ns);
+    s.fused.poses.push_back(s.fusedPose(t_ns, T_w_b));
+  }
+}
+
+void GnssFusion::addFix(const GnssFix& fix) {
+  GnssFix shifted = fix;
+  shifted.t_ns +=
+      static_cast<std::int64_t>(std::llround(impl_->config.receiver_time_offset_s * 1e9));
+  impl_->pending.push_back(shifted);
+}
+
+void GnssFusion::finish() {
+  Impl& s = *impl_;
+  while (!s.pending.empty()) {
+    s.processFix(s.pending.front());
+    s.pending.pop_front();
+  }
+  if (s.last_accepted_ns && !s.vio.empty() &&
+      static_cast<double>(s.vio.t_ns.back() - *s.last_accepted_ns) * 1e-9 > s.config.outage_s) {
+    s.stats.outages.emplace_back(*s.last_accepted_ns, s.vio.t_ns.back());
+  }
+}
+
+Trajectory GnssFusion::fusedTrajectory() const {
+  return impl_->fused;
+}
+const FusionStats& GnssFusion::stats() const {
+  return impl_->stats;
+}
+std::optional<Eigen::Isometry3d> GnssFusion::T_enu_w() const {
+  return impl_->T_enu_w;
+}
+
+}  // namespace gvio::fusion

@@ -1,0 +1,85 @@
+#pragma once
+// GNSS-assisted VIO, loosely coupled and online: VIO poses and GNSS fixes stream in time order and
+// every VIO pose gets a fused body pose in local ENU as soon as it arrives (causal). Two modes:
+//  - kf: the reference method's 6-state Kalman filter on the VIO position/velocity error after a
+//    rigid VIO-world -> ENU registration (fusion/kf_baseline.hpp);
+//  - graph (ours): VIO relative-pose factors + robust GNSS position factors with chi-square gating,
+//    per-fix sigma, lever arm, over a bounded window with a marginalisation prior
+//    (fusion/graph_window.hpp).
+// During outages both coast on the VIO motion; the intervals are reported.
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "fusion/geodesy.hpp"
+#include "fusion/kf_baseline.hpp"
+#include "fusion/vio_enu_alignment.hpp"
+#include "odometry/measurements.hpp"
+#include "odometry/trajectory.hpp"
+
+namespace gvio::fusion {
+
+enum class FusionMode { kKf, kGraph };
+std::string toString(FusionMode mode);
+FusionMode parseFusionMode(const std::string& name);  // "kf" | "graph"; throws InvalidInput
+
+struct FusionConfig {
+  FusionMode mode = FusionMode::kGraph;
+  Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();  // antenna in the body frame (m)
+  double receiver_time_offset_s = 0.0;  // added to every fix stamp (receiver clock latency)
+  AlignmentDof alignment = AlignmentDof::kYawTranslation;  // full rotation without an IMU
+  int alignment_min_fixes = 5;
+  double alignment_min_extent_m = 20.0;
+  // VIO relative-motion noise between consecutive nodes: drift per metre travelled plus a floor.
+  double vio_drift_fraction = 0.004;
+  double vio_sigma_floor_m = 0.02;
+  double vio_rot_drift_rad_per_m = 5e-5;
+  double vio_rot_floor_rad = 5e-4;
+  int window_nodes = 20;
+  double huber_sigmas = 2.0;
+  double gate_chi2 = 16.27;            // chi-square, 3 degrees of freedom, 99.9 %
+  int max_consecutive_rejections = 5;  // then the next fix is accepted (re-convergence)
+  double outage_s = 3.0;               // no accepted fix for longer than this is an outage
+  KfConfig kf;
+  void validate() const;  // throws InvalidInput naming the field
+};
+
+struct FusionStats {
+  int fixes_used = 0;
+  int fixes_rejected = 0;   // chi-square gate
+  int fixes_unmatched = 0;  // outside the VIO trajectory (before it starts, after it ends, gaps)
+  int poses_before_alignment = 0;  // fused with the first registration, back-filled
+  std::vector<std::pair<std::int64_t, std::int64_t>> outages;  // [t0, t1] without accepted fixes
+  std::vector<double> ms_per_fix;  // fusion cost of each processed fix (informational)
+};
+
+class GnssFusion {
+ public:
+  GnssFusion(const FusionConfig& config, const EnuFrame& enu);
+  ~GnssFusion();
+  GnssFusion(const GnssFusion&) = delete;
+  GnssFusion& operator=(const GnssFusion&) = delete;
+
+  // VIO body pose in the VIO world, in time order.
+  void addVioPose(std::int64_t t_ns, const Eigen::Isometry3d& T_w_b);
+  // A screened fix (fusion/gnss_screening.hpp), in time order; used once VIO poses bracket it.
+  void addFix(const GnssFix& fix);
+  // Processes the fixes still waiting and closes the last outage.
+  void finish();
+
+  // T_enu_b of every VIO pose added (empty until the first registration succeeds).
+  [[nodiscard]] Trajectory fusedTrajectory() const;
+  [[nodiscard]] const FusionStats& stats() const;
+  [[nodiscard]] std::optional<Eigen::Isometry3d> T_enu_w() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace gvio::fusion

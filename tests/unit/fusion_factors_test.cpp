@@ -1,0 +1,68 @@
+// Jacobians of the GNSS fusion graph's factors against central differences through the pose
+// manifold, and their zero residual at the true state.
+#include <gtest/gtest.h>
+
+#include <array>
+
+#include "fusion/gnss_factors.hpp"
+#include "odometry/lie.hpp"
+#include "odometry/pose_manifold.hpp"
+#include "support/ceres_jacobian.hpp"
+
+namespace gvio::fusion {
+namespace {
+
+using test::analyticTangentJacobian;
+using test::numericTangentJacobian;
+
+std::vector<double> poseBlock(const Eigen::Vector3d& phi, const Eigen::Vector3d& p) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = odometry::expSo3(phi);
+  T.translation() = p;
+  std::vector<double> x(7);
+  odometry::poseToBlock(T, x.data());
+  return x;
+}
+
+TEST(RelativePoseFactor, ZeroAtTheMeasurementAndJacobians) {
+  std::vector<std::vector<double>> blocks = {
+      poseBlock(Eigen::Vector3d(0.1, -0.2, 1.3), Eigen::Vector3d(10, -5, 2)),
+      poseBlock(Eigen::Vector3d(0.05, 0.1, 1.6), Eigen::Vector3d(14, -2, 2.5))};
+  const Eigen::Isometry3d T_i = odometry::poseFromBlock(blocks[0].data());
+  const Eigen::Isometry3d T_j = odometry::poseFromBlock(blocks[1].data());
+  const RelativePoseFactor exact(T_i.inverse() * T_j, 0.01, 0.1);
+  const double* params[] = {blocks[0].data(), blocks[1].data()};
+  Eigen::Matrix<double, 6, 1> r;
+  ASSERT_TRUE(exact.Evaluate(params, r.data(), nullptr));
+  EXPECT_LT(r.norm(), 1e-9);
+  Eigen::Isometry3d noisy = T_i.inverse() * T_j;
+  noisy.translation() += Eigen::Vector3d(0.3, -0.1, 0.2);
+  noisy.linear() = noisy.linear() * odometry::expSo3(Eigen::Vector3d(0.02, 0.05, -0.03));
+  const RelativePoseFactor factor(noisy, 0.01, 0.1);
+  for (std::size_t b = 0; b < 2; ++b) {
+    const auto num = numericTangentJacobian<6>(factor, blocks, b, true);
+    const auto ana = analyticTangentJacobian<6>(factor, blocks, b, true);
+    EXPECT_LT((num - ana).norm(), 1e-5 * std::max(1.0, ana.norm())) << "block " << b;
+  }
+}
+
+TEST(GnssPositionFactor, ZeroAtTheAntennaAndJacobian) {
+  std::vector<std::vector<double>> blocks = {
+      poseBlock(Eigen::Vector3d(0.02, -0.01, 2.0), Eigen::Vector3d(100, 50, 3))};
+  const Eigen::Isometry3d T = odometry::poseFromBlock(blocks[0].data());
+  const Eigen::Vector3d q_b(1.2, 0.3, 1.5);
+  const GnssPositionFactor exact(q_b, T * q_b, 1.5, 3.0);
+  const double* params[] = {blocks[0].data()};
+  Eigen::Vector3d r;
+  ASSERT_TRUE(exact.Evaluate(params, r.data(), nullptr));
+  EXPECT_LT(r.norm(), 1e-9);
+  const GnssPositionFactor off(q_b, T * q_b + Eigen::Vector3d(1.5, 0.0, 3.0), 1.5, 3.0);
+  ASSERT_TRUE(off.Evaluate(params, r.data(), nullptr));
+  EXPECT_LT((r - Eigen::Vector3d(-1, 0, -1)).norm(), 1e-9);  // whitened per axis
+  const auto num = numericTangentJacobian<3>(off, blocks, 0, true);
+  const auto ana = analyticTangentJacobian<3>(off, blocks, 0, true);
+  EXPECT_LT((num - ana).norm(), 1e-5 * std::max(1.0, ana.norm()));
+}
+
+}  // namespace
+}  // namespace gvio::fusion
