@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 
 #include "odometry/lie.hpp"
@@ -24,7 +25,7 @@ Eigen::Matrix<double, 3, 2> tangentBasis(const Eigen::Vector3d& g) {
 }
 
 // Linear system over x = [v_0 .. v_{n-1}, extra...] for the preintegration equations
-//   v_k dt + 0.5 g dt^2 - s (p_{k+1} - p_k) = -R_k dp_k
+//   v_k dt + 0.5 g dt^2 - s (p_{k+1} - p_k) = -R_k dp_k + (l_{k+1} - l_k)   (l: lever_v)
 //   v_{k+1} - v_k - g dt                    =  R_k dv_k
 // where g = g0 + B w when refining (B: 3x2 basis, w unknown) or g unknown (3), s optional.
 struct LinearLayout {
@@ -37,12 +38,18 @@ struct LinearLayout {
   [[nodiscard]] int scaleCol() const { return 3 * n + gravityCols(); }
 };
 
-std::optional<Eigen::VectorXd> solveLinear(const std::vector<AlignmentFrame>& frames,
-                                           const LinearLayout& L, const Eigen::Vector3d& g0,
-                                           const Eigen::Matrix<double, 3, 2>& B) {
+struct LinearSolution {
+  Eigen::VectorXd x;
+  double scale_variance = 0.0;  // of x(scaleCol) when the scale is estimated
+};
+
+std::optional<LinearSolution> solveLinear(const std::vector<AlignmentFrame>& frames,
+                                          const LinearLayout& L, const Eigen::Vector3d& g0,
+                                          const Eigen::Matrix<double, 3, 2>& B) {
   const int dim = L.size();
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(dim, dim);
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(dim);
+  double yty = 0.0;
   for (int k = 0; k + 1 < L.n; ++k) {
     const AlignmentFrame& a = frames[static_cast<std::size_t>(k)];
     const AlignmentFrame& b = frames[static_cast<std::size_t>(k) + 1];
@@ -67,6 +74,7 @@ std::optional<Eigen::VectorXd> solveLinear(const std::vector<AlignmentFrame>& fr
       A.block<3, 3>(3, L.gravityCol()) = G_v;
     }
     const Eigen::Vector3d dp_visual = b.p_v_b - a.p_v_b;
+    y.head<3>() += b.lever_v - a.lever_v;  // metric: moves with the rotation, not the scale
     if (L.scale) {
       A.block<3, 1>(0, L.scaleCol()) = -dp_visual;
     } else {
@@ -74,6 +82,7 @@ std::optional<Eigen::VectorXd> solveLinear(const std::vector<AlignmentFrame>& fr
     }
     H += A.transpose() * A;
     rhs += A.transpose() * y;
+    yty += y.squaredNorm();
   }
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
   if (ldlt.info() != Eigen::Success) return std::nullopt;
@@ -81,9 +90,19 @@ std::optional<Eigen::VectorXd> solveLinear(const std::vector<AlignmentFrame>& fr
   if (ldlt.vectorD().cwiseAbs().minCoeff() < 1e-10 * std::max(1.0, H.diagonal().maxCoeff())) {
     return std::nullopt;
   }
-  Eigen::VectorXd x = ldlt.solve(rhs);
-  if (!x.allFinite()) return std::nullopt;
-  return x;
+  LinearSolution out;
+  out.x = ldlt.solve(rhs);
+  if (!out.x.allFinite()) return std::nullopt;
+  if (L.scale) {
+    // Covariance = H^-1 * residual variance (unit weights; the residual sets the noise level).
+    const int rows = 6 * (L.n - 1);
+    const double ssr = std::max(0.0, yty - 2.0 * out.x.dot(rhs) + out.x.dot(H * out.x));
+    const double variance = ssr / std::max(1, rows - dim);
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(dim);
+    e(L.scaleCol()) = 1.0;
+    out.scale_variance = ldlt.solve(e)(L.scaleCol()) * variance;
+  }
+  return out;
 }
 
 }  // namespace
@@ -112,7 +131,8 @@ Eigen::Matrix3d gravityAlignment(const Eigen::Vector3d& g_v) {
 }
 
 std::optional<AlignmentResult> alignVisualInertial(std::vector<AlignmentFrame>& frames,
-                                                   bool estimate_scale, double gravity_tolerance) {
+                                                   bool estimate_scale, double gravity_tolerance,
+                                                   double max_scale_rel_sigma) {
   if (frames.size() < 3) return std::nullopt;
   for (std::size_t k = 1; k < frames.size(); ++k) {
     if (!frames[k].preintegration) return std::nullopt;
@@ -129,28 +149,32 @@ std::optional<AlignmentResult> alignVisualInertial(std::vector<AlignmentFrame>& 
   L.n = static_cast<int>(frames.size());
   L.scale = estimate_scale;
   const Eigen::Matrix<double, 3, 2> unused = Eigen::Matrix<double, 3, 2>::Zero();
-  auto x = solveLinear(frames, L, Eigen::Vector3d::Zero(), unused);
-  if (!x) return std::nullopt;
-  Eigen::Vector3d g = x->segment<3>(L.gravityCol());
+  auto sol = solveLinear(frames, L, Eigen::Vector3d::Zero(), unused);
+  if (!sol) return std::nullopt;
+  Eigen::Vector3d g = sol->x.segment<3>(L.gravityCol());
   result.gravity_norm_before_refinement = g.norm();
   if (std::abs(g.norm() / kGravity_mps2 - 1.0) > gravity_tolerance) return std::nullopt;
-  if (estimate_scale && !((*x)(L.scaleCol()) > 0.0)) return std::nullopt;
+  if (estimate_scale && !(sol->x(L.scaleCol()) > 0.0)) return std::nullopt;
 
   // Refine on the sphere |g| = 9.81: g = g0 + B w, re-normalised after each solve.
   L.refine = true;
   for (int it = 0; it < kGravityRefinements; ++it) {
     const Eigen::Vector3d g0 = g.normalized() * kGravity_mps2;
     const Eigen::Matrix<double, 3, 2> B = tangentBasis(g0);
-    x = solveLinear(frames, L, g0, B);
-    if (!x) return std::nullopt;
-    g = (g0 + B * x->segment<2>(L.gravityCol())).normalized() * kGravity_mps2;
+    sol = solveLinear(frames, L, g0, B);
+    if (!sol) return std::nullopt;
+    g = (g0 + B * sol->x.segment<2>(L.gravityCol())).normalized() * kGravity_mps2;
   }
   result.g_v = g;
-  result.scale = estimate_scale ? (*x)(L.scaleCol()) : 1.0;
+  result.scale = estimate_scale ? sol->x(L.scaleCol()) : 1.0;
   if (!(result.scale > 0.0)) return std::nullopt;
+  if (estimate_scale) {
+    result.scale_rel_sigma = std::sqrt(std::max(0.0, sol->scale_variance)) / result.scale;
+    if (!(result.scale_rel_sigma <= max_scale_rel_sigma)) return std::nullopt;
+  }
   result.v_v.resize(frames.size());
   for (std::size_t k = 0; k < frames.size(); ++k) {
-    result.v_v[k] = x->segment<3>(3 * static_cast<int>(k));
+    result.v_v[k] = sol->x.segment<3>(3 * static_cast<int>(k));
   }
   result.R_w_v = gravityAlignment(g);
   return result;

@@ -45,6 +45,8 @@ struct VioEstimator::Impl {
   bool tryInitialize(std::int64_t t_ns, const TrackedFrame& tracked);
   bool staticInitialize(std::int64_t t_ns, const TrackedFrame& tracked);
   bool motionInitialize(std::int64_t t_ns);
+  bool monoInitialize(std::int64_t t_ns);
+  void reportWaiting(std::int64_t t_ns, const std::string& why);
   void applyAlignment(const Eigen::Matrix3d& R_w_v, const std::vector<Eigen::Vector3d>& v_v,
                       const ImuBias& bias);
 

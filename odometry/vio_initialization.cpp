@@ -1,11 +1,15 @@
 // Initialisation of the IMU modes: the window first runs on vision alone (stereo depth gives
 // metric poses; the oldest pose fixes the gauge), then gravity, velocities and the gyroscope bias
 // are found either from a standing start (static IMU and image) or by the visual-inertial
-// alignment of vi_alignment.hpp, and the window is rotated into a gravity-aligned world.
+// alignment of vi_alignment.hpp, and the window is rotated into a gravity-aligned world. A
+// monocular window in motion first needs its structure: the visual SfM of mono_sfm.hpp, then the
+// alignment with scale (VINS-Mono, Qin et al. 2018, sec. V-A and V-B).
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <string>
 
+#include "odometry/mono_sfm.hpp"
 #include "odometry/vi_alignment.hpp"
 #include "odometry/vio_estimator_impl.hpp"
 
@@ -45,8 +49,11 @@ void VioEstimator::Impl::applyAlignment(const Eigen::Matrix3d& R_w_v,
     f.setBias(bias);
     if (f.preintegration) f.preintegration->reintegrate(bias);
   }
-  // The prior was linearised in the visual frame; the IMU residuals now anchor the window.
+  // The prior was linearised in the visual frame; the IMU residuals now anchor the window. The
+  // latest estimate is still in the visual frame (and, for mono, at no scale): it is stale.
   window.clearPrior();
+  latest.valid = false;
+  previous_pose.reset();
   imu_aligned = true;
   anchorWindow();
   ++counters.initializations;
@@ -109,10 +116,7 @@ bool VioEstimator::Impl::motionInitialize(std::int64_t t_ns) {
   }
   const auto result = alignVisualInertial(af, false);
   if (!result) {
-    if (!waiting_reported) {
-      event(t_ns, "waiting", "visual-inertial alignment not yet well conditioned: waiting");
-      waiting_reported = true;
-    }
+    reportWaiting(t_ns, "visual-inertial alignment not yet well conditioned: waiting");
     return false;
   }
   ImuBias bias;
@@ -125,18 +129,98 @@ bool VioEstimator::Impl::motionInitialize(std::int64_t t_ns) {
   return true;
 }
 
+void VioEstimator::Impl::reportWaiting(std::int64_t t_ns, const std::string& why) {
+  if (waiting_reported) return;
+  event(t_ns, "waiting", why);
+  waiting_reported = true;
+}
+
+bool VioEstimator::Impl::monoInitialize(std::int64_t t_ns) {
+  auto& frames = window.frames();
+  const auto n = static_cast<int>(frames.size());
+  if (frames.size() < kMinAlignmentFrames ||
+      static_cast<double>(frames.back()->t_ns - frames.front()->t_ns) * 1e-9 <
+          config.init_window_s) {
+    return false;
+  }
+  for (std::size_t k = 1; k < frames.size(); ++k) {
+    if (!frames[k]->preintegration) return false;
+  }
+  // Feature tracks of the window in normalised coordinates of the left camera.
+  std::map<std::uint64_t, int> index;
+  for (int k = 0; k < n; ++k) index[frames[static_cast<std::size_t>(k)]->uid] = k;
+  std::vector<SfmTrack> tracks;
+  for (const auto& [id, lm] : window.landmarks().all()) {
+    SfmTrack t;
+    t.id = id;
+    for (const Observation& o : lm.observations) {
+      const auto it = index.find(o.frame_uid);
+      if (it != index.end())
+        t.observations.emplace_back(it->second, geometry.bearing(o.px_left).head<2>());
+    }
+    if (t.observations.size() >= 2) tracks.push_back(std::move(t));
+  }
+  SfmOptions options;
+  options.focal_px = geometry.left.fx;
+  const auto sfm = solveMonoSfm(tracks, n, options);
+  if (!sfm) {
+    reportWaiting(t_ns, "mono+IMU: not enough parallax for the visual SfM yet: waiting");
+    return false;
+  }
+  // Body poses: R_v_b = R_v_c R_c_b, p_v_b = s p_v_c + R_v_c t_c_b (the lever arm is metric).
+  const Eigen::Isometry3d T_c_b = geometry.left.T_b_c.inverse();
+  std::vector<AlignmentFrame> af(frames.size());
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const Eigen::Isometry3d& T_v_c = sfm->T_v_c[k];
+    af[k].R_v_b = T_v_c.rotation() * T_c_b.rotation();
+    af[k].p_v_b = T_v_c.translation();
+    af[k].lever_v = T_v_c.rotation() * T_c_b.translation();
+    if (k > 0) af[k].preintegration = frames[k]->preintegration;
+  }
+  const auto result = alignVisualInertial(af, true);
+  if (!result) {
+    reportWaiting(t_ns,
+                  "mono+IMU: scale not yet observable (SfM solved, alignment waits for "
+                  "acceleration): waiting");
+    return false;
+  }
+  const double s = result->scale;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = af[k].R_v_b;
+    T.translation() = s * af[k].p_v_b + af[k].lever_v;
+    poseToBlock(T, frames[k]->pose.data());
+  }
+  // Landmark depths in their anchor camera, metric: inv_depth = inv_depth_visual / s.
+  for (auto& [id, lm] : window.landmarks().all()) {
+    lm.has_depth = false;
+    const auto p = sfm->points_v.find(id);
+    const auto anchor = index.find(lm.anchor().frame_uid);
+    if (p == sfm->points_v.end() || anchor == index.end()) continue;
+    const double depth =
+        s * (sfm->T_v_c[static_cast<std::size_t>(anchor->second)].inverse() * p->second).z();
+    if (depth >= config.min_depth_m && depth <= config.max_depth_m) {
+      lm.inv_depth = 1.0 / depth;
+      lm.has_depth = true;
+    }
+  }
+  ImuBias bias;
+  bias.gyr = result->gyr_bias;
+  applyAlignment(result->R_w_v, result->v_v, bias);
+  event(t_ns, "initialized",
+        "mono SfM (" + std::to_string(sfm->points_v.size()) + " points, " + fmt3(sfm->rms_px) +
+            " px rms) + visual-inertial alignment over " + std::to_string(frames.size()) +
+            " frames: scale " + fmt3(s) + " (+-" + fmt3(100.0 * result->scale_rel_sigma) +
+            " %), |g| before refinement " + fmt3(result->gravity_norm_before_refinement) +
+            " m/s^2");
+  return true;
+}
+
 bool VioEstimator::Impl::tryInitialize(std::int64_t t_ns, const TrackedFrame& tracked) {
   if (window.frames().empty()) return false;
   if (staticInitialize(t_ns, tracked)) return true;
-  // A monocular window has no metric structure before the IMU is aligned, so only a standing
-  // start initialises it (the alignment would need the visual SfM of VINS-Mono).
-  if (!geometry.stereo) {
-    if (!waiting_reported) {
-      event(t_ns, "waiting", "mono+IMU initialises from a standing start: waiting");
-      waiting_reported = true;
-    }
-    return false;
-  }
+  // A monocular window has no metric structure before the IMU is aligned: SfM first.
+  if (!geometry.stereo) return monoInitialize(t_ns);
   return motionInitialize(t_ns);
 }
 

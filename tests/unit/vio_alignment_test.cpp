@@ -79,6 +79,45 @@ TEST(ViAlignment, EstimatesScaleForAMonocularWindow) {
   EXPECT_NEAR(result->scale, 2.0, 0.02);
 }
 
+TEST(ViAlignment, EstimatesScaleWithACameraLeverArm) {
+  // A monocular camera 1.5 m from the IMU: vision sees the camera's path at half the true size,
+  // and the lever arm R_v_c t_c_b (metric) moves with the body's rotation only.
+  Truth truth = makeTruth(Eigen::Vector3d::Zero(), expSo3(Eigen::Vector3d(0.1, -0.2, 0.4)));
+  const Eigen::Vector3d t_b_c(0.8, -0.3, 1.2);  // camera position in the body
+  for (AlignmentFrame& f : truth.frames) {
+    const Eigen::Vector3d p_v_c = f.p_v_b + f.R_v_b * t_b_c;
+    f.p_v_b = 0.5 * p_v_c;
+    f.lever_v = -f.R_v_b * t_b_c;  // R_v_c t_c_b with the camera axes of the body
+  }
+  const auto result = alignVisualInertial(truth.frames, true);
+  ASSERT_TRUE(result.has_value());
+  EXPECT_NEAR(result->scale, 2.0, 1e-3);
+  EXPECT_LT(result->scale_rel_sigma, 0.01);
+  for (std::size_t k = 0; k < truth.v_v.size(); ++k) {
+    EXPECT_LT((result->v_v[k] - truth.v_v[k]).norm(), 0.02) << "frame " << k;
+  }
+}
+
+TEST(ViAlignment, RefusesAnUnobservableScale) {
+  // Constant velocity, no rotation: s (p_{k+1} - p_k) = v dt holds for every s, so only the
+  // visual noise (1 mm here) decides the scale: the alignment must wait rather than guess.
+  const Eigen::Vector3d g_w(0, 0, -kGravity_mps2), v(8.0, 0.5, 0.0);
+  std::vector<AlignmentFrame> frames;
+  std::shared_ptr<ImuPreintegration> pending;
+  for (int k = 0; k <= 12; ++k) {
+    AlignmentFrame f;
+    const double n = static_cast<double>(k);
+    f.p_v_b = 0.1 * n * v +
+              1e-3 * Eigen::Vector3d(std::sin(1.3 * n), std::cos(2.1 * n), std::sin(0.7 * n));
+    f.preintegration = pending;
+    frames.push_back(f);
+    pending = std::make_shared<ImuPreintegration>(ImuBias{}, ImuNoise{});
+    for (int s = 0; s < 20; ++s) pending->integrate(0.005, -g_w, Eigen::Vector3d::Zero());
+  }
+  EXPECT_FALSE(alignVisualInertial(frames, true).has_value());
+  EXPECT_TRUE(alignVisualInertial(frames, false).has_value());  // stereo: scale known
+}
+
 TEST(ViAlignment, RefusesAnInconsistentWindow) {
   // An accelerometer reading 1.5x too much: the free gravity estimate is far from 9.81 m/s^2.
   Truth truth = makeTruth(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), 1.5);

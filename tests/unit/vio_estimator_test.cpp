@@ -42,9 +42,10 @@ struct Perturbation {
 };
 
 RunOutput runOn(const io::Dataset& ds, EstimatorConfig config, const Perturbation& p = {}) {
-  const Rectifier rectifier(ds.cameras[0], ds.cameras.size() > 1
-                                               ? std::optional<CameraModel>(ds.cameras[1])
-                                               : std::nullopt);
+  // Mono: the left camera alone (rectified on its own, no right image needed).
+  const bool stereo = usesStereo(config.mode) && ds.cameras.size() > 1;
+  const Rectifier rectifier(ds.cameras[0],
+                            stereo ? std::optional<CameraModel>(ds.cameras[1]) : std::nullopt);
   if (ds.imu_noise) config.imu_noise = *ds.imu_noise;
   VioEstimator vio(config, rectifier.left(),
                    usesStereo(config.mode) ? rectifier.right() : std::nullopt);
@@ -119,6 +120,25 @@ TEST_F(VioDrive, StereoOnlyRegression) {
   EXPECT_TRUE(out.all_finite);
   EXPECT_EQ(out.trajectory.size(), ds().frames.size());
   EXPECT_LT(apeRmse(ds(), out.trajectory), 0.25);
+}
+
+// Measured 0.374 m APE RMSE (over the 20 s after initialisation, 155 m) for mono+IMU.
+TEST_F(VioDrive, MonoImuInitialisesWhileMoving) {
+  // The drive starts at 8 m/s and keeps that speed, so the scale is unobservable until the first
+  // turn (from 10.2 s, 3 m/s^2 centripetal): the window initialises from the mono SfM then.
+  EstimatorConfig config;
+  config.mode = VioMode::kMonoImu;
+  const RunOutput out = runOn(ds(), config);
+  EXPECT_TRUE(out.all_finite);
+  EXPECT_TRUE(out.hasEvent("waiting"));
+  EXPECT_TRUE(out.hasEvent("initialized"));
+  EXPECT_EQ(out.counters.initializations, 1);
+  ASSERT_FALSE(out.trajectory.empty());
+  EXPECT_LE(out.trajectory.t_ns.front() - ds().frames.front().t_ns, 11'000'000'000);
+  // Every frame after the initialisation estimated.
+  EXPECT_GE(out.trajectory.size() + 115, ds().frames.size());
+  EXPECT_EQ(out.trajectory.t_ns.back(), ds().frames.back().t_ns);
+  EXPECT_LT(apeRmse(ds(), out.trajectory), 0.75);
 }
 
 TEST_F(VioDrive, CoastsThroughBlackFramesOnTheImu) {
