@@ -6,6 +6,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <map>
 
 #include "io/input_error.hpp"
@@ -153,6 +154,24 @@ void applyOverride(const std::string& assignment, std::map<std::string, ConfigKe
 
 }  // namespace
 
+std::optional<fusion::Lla> FusionAppConfig::originLla() const {
+  if (origin == "first-fix") return std::nullopt;
+  fusion::Lla lla;
+  char tail = 0;
+  if (std::sscanf(origin.c_str(), "%lf,%lf,%lf%c", &lla.lat_deg, &lla.lon_deg, &lla.h_ellipsoid_m,
+                  &tail) != 3 ||
+      !fusion::isValidLla(lla)) {
+    throw InvalidInput("config: fusion.origin must be first-fix or lat,lon,h (got '" + origin +
+                       "')");
+  }
+  return lla;
+}
+
+void FusionAppConfig::validate() const {
+  (void)originLla();
+  fusion.validate();
+}
+
 void VioConfig::validate() const {
   if (mode != "auto" && mode != "stereo-imu" && mode != "mono-imu" && mode != "stereo") {
     throw InvalidInput("config: vio.mode must be one of auto, stereo-imu, mono-imu, stereo (got '" +
@@ -175,6 +194,7 @@ void AppConfig::validate() const {
   dataset.validate();
   imu.noise.validate();
   vio.validate();
+  fusion.validate();
   sim.validate();
 }
 
@@ -224,6 +244,24 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("vio.tracker.fb_threshold_px", e.tracker.fb_threshold_px),
       number("vio.tracker.ransac_threshold_px", e.tracker.ransac_threshold_px),
       number("vio.tracker.stereo_max_vertical_px", e.tracker.stereo_max_vertical_px),
+      text("fusion.origin", c.fusion.origin),
+      vector3("fusion.lever_arm_b", c.fusion.fusion.lever_arm_b),
+      number("fusion.receiver_time_offset_s", c.fusion.fusion.receiver_time_offset_s),
+      integer("fusion.alignment_min_fixes", c.fusion.fusion.alignment_min_fixes),
+      number("fusion.alignment_min_extent_m", c.fusion.fusion.alignment_min_extent_m),
+      number("fusion.vio_drift_fraction", c.fusion.fusion.vio_drift_fraction),
+      number("fusion.vio_sigma_floor_m", c.fusion.fusion.vio_sigma_floor_m),
+      number("fusion.vio_rot_drift_rad_per_m", c.fusion.fusion.vio_rot_drift_rad_per_m),
+      number("fusion.vio_rot_floor_rad", c.fusion.fusion.vio_rot_floor_rad),
+      integer("fusion.window_nodes", c.fusion.fusion.window_nodes),
+      number("fusion.huber_sigmas", c.fusion.fusion.huber_sigmas),
+      number("fusion.gate_chi2", c.fusion.fusion.gate_chi2),
+      integer("fusion.max_consecutive_rejections", c.fusion.fusion.max_consecutive_rejections),
+      number("fusion.outage_s", c.fusion.fusion.outage_s),
+      number("fusion.kf.q_position", c.fusion.fusion.kf.q_position),
+      number("fusion.kf.q_velocity", c.fusion.fusion.kf.q_velocity),
+      number("fusion.kf.initial_position_sigma_m", c.fusion.fusion.kf.initial_position_sigma_m),
+      number("fusion.kf.initial_velocity_sigma_mps", c.fusion.fusion.kf.initial_velocity_sigma_mps),
       number("sim.origin_lat_deg", c.sim.origin_lat_deg),
       number("sim.origin_lon_deg", c.sim.origin_lon_deg),
       number("sim.origin_h_m", c.sim.origin_h_m),

@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fusion/gnss_fusion.hpp"
 #include "io/reader_config.hpp"
 #include "odometry/measurements.hpp"
 #include "odometry/vio_config.hpp"
@@ -31,10 +32,22 @@ struct VioConfig {
   void validate() const;  // throws InvalidInput naming the key
 };
 
+// gvio run's GNSS fusion (YAML section `fusion:`); the mode comes from --gnss.
+struct FusionAppConfig {
+  // Origin of the local ENU frame: "first-fix", or "lat,lon,h" (deg, deg, ellipsoidal m).
+  std::string origin = "first-fix";
+  fusion::FusionConfig fusion;
+
+  // The origin as given, nullopt for first-fix; throws InvalidInput for malformed text.
+  [[nodiscard]] std::optional<fusion::Lla> originLla() const;
+  void validate() const;  // throws InvalidInput naming the key
+};
+
 struct AppConfig {
   io::ReaderConfig dataset;
   ImuConfig imu;
   VioConfig vio;
+  FusionAppConfig fusion;
   sim::SimConfig sim;
 
   void validate() const;  // throws InvalidInput naming the key

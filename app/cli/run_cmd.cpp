@@ -7,10 +7,12 @@
 #include <filesystem>
 
 #include "cli/app.hpp"
+#include "eval/evaluate.hpp"
 #include "io/atomic_write.hpp"
 #include "io/trajectory_io.hpp"
 #include "odometry/error.hpp"
 #include "run/evaluation.hpp"
+#include "run/gnss_run.hpp"
 #include "run/report.hpp"
 #include "run/stats.hpp"
 #include "run/vio_runner.hpp"
@@ -29,12 +31,27 @@ struct RunOptions {
 
 // Checked here rather than by CLI11 so that a bad value is the usual one-line error (exit 2).
 void checkGnssOption(const std::string& gnss) {
-  if (gnss == "kf" || gnss == "graph") {
-    throw InvalidInput("--gnss " + gnss +
-                       ": GNSS fusion is not available in this build (use --gnss auto or off)");
-  }
-  if (gnss != "auto" && gnss != "off") {
+  if (gnss != "auto" && gnss != "off" && gnss != "kf" && gnss != "graph") {
     throw InvalidInput("--gnss '" + gnss + "': expected auto, off, kf or graph");
+  }
+}
+
+// The fused trajectory against the ground truth with no alignment at all: both must be in the same
+// local ENU frame (fusion.origin set to the truth's origin, as for simulated drives).
+nlohmann::json evaluateFused(const Trajectory& truth, const Trajectory& fused) {
+  try {
+    eval::EvalOptions options;
+    options.align = eval::Alignment::kNone;
+    const eval::EvalResult r = eval::evaluate(truth, fused, options);
+    return {{"ape_none",
+             {{"rmse", r.ape_stats.rmse},
+              {"mean", r.ape_stats.mean},
+              {"median", r.ape_stats.median},
+              {"max", r.ape_stats.max},
+              {"n", r.ape.size()}}},
+            {"note", "no alignment, in the ENU frame of fusion.origin (the truth's must match)"}};
+  } catch (const InvalidInput& e) {
+    return {{"error", e.what()}};
   }
 }
 
@@ -61,9 +78,12 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
   estimator.validate();
   const fs::path out = opt.out;
   makeOutputDir(out);
-  if (opt.gnss == "auto") {
-    spdlog::info("GNSS fusion is not available in this build: {} fixes are counted, not used",
-                 ds.gnss.size());
+  std::optional<fusion::FusionMode> gnss_mode;
+  if (opt.gnss == "kf" || opt.gnss == "graph") gnss_mode = fusion::parseFusionMode(opt.gnss);
+  if (opt.gnss == "auto" && !ds.gnss.empty()) gnss_mode = fusion::FusionMode::kGraph;
+  if (gnss_mode && ds.gnss.empty()) {
+    spdlog::warn("--gnss {}: the dataset has no GNSS fixes: pure VIO", opt.gnss);
+    gnss_mode.reset();
   }
   spdlog::info("{} {} ({}): {} frames, mode {}", io::toString(ds.format), ds.root.string(),
                ds.variant, ds.frames.size(), odometry::toString(estimator.mode));
@@ -88,6 +108,12 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
     evaluation = run::evaluateAgainstTruth(*ds.groundtruth, result.trajectory);
     if (!evaluation->result) spdlog::warn("no evaluation: {}", evaluation->error);
   }
+  std::optional<run::GnssRunResult> gnss;
+  if (gnss_mode) {
+    gnss = run::fuseGnss(ds, result.trajectory, *gnss_mode, config.fusion.fusion,
+                         config.fusion.originLla(), odometry::usesImu(estimator.mode));
+    if (gnss) run::writeGeoreferencedOutputs(out, *gnss);
+  }
   run::ReportContext context;
   context.command_line = common.command_line;
   context.gnss_requested = opt.gnss;
@@ -95,7 +121,18 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
     context.imu_noise_source = dataset_noise ? "dataset" : "config";
   context.peak_rss_mb = run::peakRssMb();
   context.evaluation = evaluation ? &*evaluation : nullptr;
-  io::writeTextAtomic(out / "report.json", run::buildReport(ds, result, context).dump(2) + "\n");
+  nlohmann::json report = run::buildReport(ds, result, context);
+  if (gnss) {
+    report["gnss"] = run::gnssReport(*gnss, ds.gnss.size());
+    report["gnss"]["requested"] = opt.gnss;
+    report["outages"] = run::outagesReport(*gnss);
+    // Without alignment the truth must be in the same ENU frame: only with an explicit origin.
+    if (ds.groundtruth && ds.groundtruth->hasTimestamps() && !gnss->fused.empty() &&
+        config.fusion.originLla()) {
+      report["evaluation_fused"] = evaluateFused(*ds.groundtruth, gnss->fused);
+    }
+  }
+  io::writeTextAtomic(out / "report.json", report.dump(2) + "\n");
   io::writeTextAtomic(out / "config.yaml", dumpConfigYaml(config));
 
   const run::TimingSummary total = run::summarizeTimings(result.timings.total_ms);
@@ -105,6 +142,16 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
               ? fmt::format("APE (SE3) rmse {:.3f} m over {:.0f} m",
                             evaluation->result->ape_se3.rmse, evaluation->result->path_length_m)
               : "not evaluated";
+  }
+  if (gnss) {
+    std::string fused_ape;
+    if (report.contains("evaluation_fused") && report["evaluation_fused"].contains("ape_none")) {
+      fused_ape = fmt::format(", fused APE (no alignment) rmse {:.3f} m",
+                              report["evaluation_fused"]["ape_none"]["rmse"].get<double>());
+    }
+    spdlog::info("GNSS {}: {} fixes used, {} rejected, {} skipped, {} outage(s){}",
+                 fusion::toString(gnss->mode), gnss->stats.fixes_used, gnss->stats.fixes_rejected,
+                 gnss->screening.skipped(), gnss->stats.outages.size(), fused_ape);
   }
   spdlog::info(
       "{} frames, {} keyframes, {} poses written, {}, {:.1f} ms/frame (p95 {:.1f}); wrote {}",
@@ -124,7 +171,8 @@ Command addRunCommand(CLI::App& app, const CommonOptions& common) {
       ->check(CLI::IsMember({"auto", "kitti-raw", "euroc"}))
       ->capture_default_str();
   sub->add_option("--gnss", opt->gnss,
-                  "GNSS use: auto or off (fusion with kf|graph is not in this build; auto = off)")
+                  "GNSS fusion: auto (graph when the dataset has fixes), off, kf (the reference "
+                  "Kalman filter) or graph")
       ->capture_default_str();
   sub->add_option("--out", opt->out, "Run folder (created if missing; files in it are replaced)")
       ->capture_default_str();

@@ -1,17 +1,18 @@
 #!/usr/bin/env bash
-# End-to-end VIO benchmark (issue 6): simulates the full KITTI-00 drive once (cached), runs
-# `gvio run --gnss off` in each mode, evaluates with `gvio eval` (SE(3) alignment: APE RMSE and RPE
-# per 100 m) and prints a table with ms/frame per stage (mean, p95) and peak RSS from report.json.
-# A benchmark, not a test: nothing here asserts a timing.
+# End-to-end benchmark (issues 6 and 7): simulates the full KITTI-00 drive once (cached, SPP-grade
+# GNSS), runs `gvio run` per mode, evaluates the VIO with `gvio eval` (SE(3) alignment: APE RMSE,
+# RPE per 100 m), the fused trajectory with no alignment against the ENU truth, and prints a table
+# with ms/frame per stage (mean, p95), GNSS cost per fix and peak RSS from report.json.
+# A mode is VIO_MODE:GNSS (GNSS off|kf|graph). A benchmark, not a test: nothing asserts a timing.
 #
 #   tests/bench/vio_kitti00.sh                         # all modes, full drive
-#   BENCH_MODES="stereo-imu" BENCH_SECONDS=60 tests/bench/vio_kitti00.sh
+#   BENCH_MODES="stereo-imu:graph" BENCH_SECONDS=60 tests/bench/vio_kitti00.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 BUILD_DIR="${BUILD_DIR:-build}"
 GVIO="$BUILD_DIR/app/gvio"
 DATA="${GVIO_SHARED_DATA:-../shared/data}/kitti00"
-MODES="${BENCH_MODES:-stereo-imu stereo mono-imu}"
+MODES="${BENCH_MODES:-stereo-imu:graph stereo-imu:kf stereo:off mono-imu:off}"
 SECONDS_ARG=()
 TAG="full"
 if [ -n "${BENCH_SECONDS:-}" ]; then
@@ -36,9 +37,13 @@ fi
 
 OUT="${BENCH_OUT:-out/bench/vio_kitti00_$TAG}"
 mkdir -p "$OUT"
+# The simulator's ENU origin and antenna lever arm (its defaults), so that the fused trajectory can
+# be compared with groundtruth.tum without any alignment.
+GEO=(--set "fusion.origin=48.98253,8.39035,116.4" --set "fusion.lever_arm_b=[0,0,0.8]")
 for mode in $MODES; do
-  run="$OUT/$mode"
-  "$GVIO" run --dataset "$CACHE" --gnss off --set "vio.mode=$mode" --out "$run" --no-progress
+  run="$OUT/${mode/:/_}"
+  "$GVIO" run --dataset "$CACHE" --gnss "${mode#*:}" --set "vio.mode=${mode%%:*}" "${GEO[@]}" \
+    --out "$run" --no-progress
   if [ -s "$run/trajectory_vio.tum" ]; then
     "$GVIO" eval --ref "$CACHE/groundtruth.tum" --est "$run/trajectory_vio.tum" --align se3 \
       --rpe-delta 100 --rpe-unit m --json "$run/eval.json" > /dev/null
@@ -48,13 +53,15 @@ done
 python3 - "$OUT" $MODES <<'PY'
 import json, os, sys
 out, modes = sys.argv[1], sys.argv[2:]
-print("| mode | poses | APE RMSE (m) | RPE per 100 m (mean %, rmse %) | tracking ms mean / p95 "
-      "| estimator ms mean / p95 | tracking + estimator mean (ms) | peak RSS (MB) |")
-print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+print("| mode | poses | VIO APE RMSE (m) | VIO RPE per 100 m (mean %, rmse %) | tracking ms mean / p95 "
+      "| estimator ms mean / p95 | tracking + estimator mean (ms) | peak RSS (MB) "
+      "| fused APE RMSE, no alignment (m) | GNSS used / rejected | ms per fix mean / p95 |")
+print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
 for mode in modes:
-    rep = json.load(open(os.path.join(out, mode, "report.json")))
+    run = os.path.join(out, mode.replace(":", "_"))
+    rep = json.load(open(os.path.join(run, "report.json")))
     t = rep["timing_ms"]
-    ev_path = os.path.join(out, mode, "eval.json")
+    ev_path = os.path.join(run, "eval.json")
     if os.path.exists(ev_path):
         ev = json.load(open(ev_path))
         ape = f'{ev["ape"]["rmse"]:.3f}'
@@ -65,5 +72,12 @@ for mode in modes:
     print(f'| {mode} | {rep["counts"]["poses_written"]}/{rep["counts"]["frames"]} | {ape} | {rpe} '
           f'| {t["tracking"]["mean"]:.1f} / {t["tracking"]["p95"]:.1f} '
           f'| {t["estimator"]["mean"]:.1f} / {t["estimator"]["p95"]:.1f} | {front_back:.1f} '
-          f'| {rep["peak_rss_mb"]:.0f} |')
+          f'| {rep["peak_rss_mb"]:.0f} ', end="")
+    fused = rep.get("evaluation_fused", {}).get("ape_none")
+    g = rep.get("gnss", {})
+    if fused:
+        print(f'| {fused["rmse"]:.3f} | {g["used"]} / {g["rejected"]} '
+              f'| {g["ms_per_fix"]["mean"]:.2f} / {g["ms_per_fix"]["p95"]:.2f} |')
+    else:
+        print("| - | - | - |")
 PY

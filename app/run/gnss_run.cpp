@@ -1,0 +1,133 @@
+#include "run/gnss_run.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "io/atomic_write.hpp"
+#include "io/trajectory_io.hpp"
+#include "run/stats.hpp"
+
+namespace gvio::run {
+namespace {
+
+double seconds(std::int64_t t_ns) {
+  return static_cast<double>(t_ns) * 1e-9;
+}
+
+}  // namespace
+
+std::optional<GnssRunResult> fuseGnss(const io::Dataset& ds, const Trajectory& vio,
+                                      fusion::FusionMode mode, fusion::FusionConfig config,
+                                      const std::optional<fusion::Lla>& origin, bool has_imu) {
+  if (ds.gnss.empty() || vio.empty()) return std::nullopt;
+  const std::int64_t begin = ds.frames.empty() ? vio.t_ns.front() : ds.frames.front().t_ns;
+  const std::int64_t end = ds.frames.empty() ? vio.t_ns.back() : ds.frames.back().t_ns;
+  const fusion::ScreeningResult screened = fusion::screenFixes(ds.gnss, begin, end);
+  if (screened.counts.skipped() > 0) {
+    spdlog::warn("{}: {}", ds.gnss_source, screened.counts.summary());
+  }
+  if (screened.fixes.empty()) return std::nullopt;
+  GnssRunResult r;
+  r.mode = mode;
+  r.screening = screened.counts;
+  const GnssFix& first = screened.fixes.front();
+  r.origin = origin ? *origin : fusion::Lla{first.lat_deg, first.lon_deg, first.h_ellipsoid_m};
+  config.mode = mode;
+  config.alignment =
+      has_imu ? fusion::AlignmentDof::kYawTranslation : fusion::AlignmentDof::kRotationTranslation;
+  fusion::GnssFusion fusion(config, fusion::EnuFrame(r.origin));
+  std::size_t f = 0;
+  for (std::size_t k = 0; k < vio.size(); ++k) {
+    while (f < screened.fixes.size() && screened.fixes[f].t_ns <= vio.t_ns[k]) {
+      fusion.addFix(screened.fixes[f++]);
+    }
+    fusion.addVioPose(vio.t_ns[k], vio.poses[k]);
+  }
+  while (f < screened.fixes.size()) fusion.addFix(screened.fixes[f++]);
+  fusion.finish();
+  r.stats = fusion.stats();
+  r.fused = fusion.fusedTrajectory();
+  r.T_enu_w = fusion.T_enu_w();
+  if (!r.T_enu_w) {
+    spdlog::warn(
+        "GNSS: the VIO trajectory could not be registered to ENU (too few fixes, or they "
+        "span less than {} m): no georeferenced output",
+        config.alignment_min_extent_m);
+  }
+  return r;
+}
+
+void writeGeoreferencedOutputs(const std::filesystem::path& out, const GnssRunResult& r) {
+  if (r.fused.empty()) return;
+  io::writeTum(out / "trajectory.tum", r.fused);
+  const fusion::EnuFrame enu(r.origin);
+  io::writeFileAtomic(out / "trajectory_lla.csv", [&](std::ostream& os) {
+    os << "# t_s,lat_deg,lon_deg,h_ellipsoid_m,qw,qx,qy,qz (body in local ENU)\n";
+    for (std::size_t k = 0; k < r.fused.size(); ++k) {
+      const fusion::Lla lla = enu.toLla(r.fused.poses[k].translation());
+      const Eigen::Quaterniond q(r.fused.poses[k].rotation());
+      os << fmt::format("{:.9f},{:.9f},{:.9f},{:.4f},{:.9f},{:.9f},{:.9f},{:.9f}\n",
+                        seconds(r.fused.t_ns[k]), lla.lat_deg, lla.lon_deg, lla.h_ellipsoid_m,
+                        q.w(), q.x(), q.y(), q.z());
+    }
+  });
+  const fusion::Utm utm = fusion::llaToUtm(r.origin);
+  nlohmann::json j;
+  j["enu_origin"] = {{"lat_deg", r.origin.lat_deg},
+                     {"lon_deg", r.origin.lon_deg},
+                     {"h_ellipsoid_m", r.origin.h_ellipsoid_m},
+                     {"crs", "EPSG:4979"}};
+  j["utm"] = {{"zone", utm.zone},
+              {"north", utm.north},
+              {"epsg", utm.epsg()},
+              {"origin_easting_m", utm.easting_m},
+              {"origin_northing_m", utm.northing_m}};
+  j["frames"] = {
+      {"enu", "local east-north-up tangent at enu_origin (GeographicLib LocalCartesian), metres"},
+      {"body", "the IMU frame; trajectory.tum and trajectory_lla.csv give the body pose in ENU"},
+      {"vio_world", "trajectory_vio.tum's frame; T_enu_w maps it to ENU"}};
+  if (r.T_enu_w) {
+    const Eigen::Quaterniond q(r.T_enu_w->rotation());
+    const Eigen::Vector3d t = r.T_enu_w->translation();
+    j["T_enu_w"] = {{"translation_m", {t.x(), t.y(), t.z()}},
+                    {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
+  }
+  j["heights"] =
+      "ellipsoidal (WGS84); NMEA MSL heights are converted with the receiver's geoid "
+      "separation";
+  j["time_base"] = "dataset timestamps in seconds (the same clock as trajectory_vio.tum)";
+  io::writeTextAtomic(out / "georef.json", j.dump(2) + "\n");
+}
+
+nlohmann::json gnssReport(const GnssRunResult& r, std::size_t fixes_in_dataset) {
+  const TimingSummary cost = summarizeTimings(r.stats.ms_per_fix);
+  return {{"mode", fusion::toString(r.mode)},
+          {"fixes", fixes_in_dataset},
+          {"used", r.stats.fixes_used},
+          {"rejected", r.stats.fixes_rejected},
+          {"unmatched", r.stats.fixes_unmatched},
+          {"skipped", r.screening.skipped()},
+          {"skipped_reasons",
+           {{"non_finite", r.screening.non_finite},
+            {"bad_sigma", r.screening.bad_sigma},
+            {"out_of_range", r.screening.out_of_range},
+            {"outside_drive", r.screening.outside_drive},
+            {"out_of_order", r.screening.out_of_order}}},
+          {"registered", r.T_enu_w.has_value()},
+          {"poses_before_registration", r.stats.poses_before_alignment},
+          {"ms_per_fix", {{"mean", cost.mean}, {"p95", cost.p95}, {"max", cost.max}}},
+          {"enu_origin",
+           {{"lat_deg", r.origin.lat_deg},
+            {"lon_deg", r.origin.lon_deg},
+            {"h_ellipsoid_m", r.origin.h_ellipsoid_m}}}};
+}
+
+nlohmann::json outagesReport(const GnssRunResult& r) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& [t0, t1] : r.stats.outages) {
+    a.push_back({{"t0", seconds(t0)}, {"t1", seconds(t1)}, {"duration_s", seconds(t1 - t0)}});
+  }
+  return a;
+}
+
+}  // namespace gvio::run

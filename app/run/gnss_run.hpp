@@ -1,0 +1,41 @@
+#pragma once
+// gvio run's GNSS stage: screens the dataset's fixes, fuses them with the VIO trajectory
+// (fusion::GnssFusion, causal: replaying the recorded VIO poses in time order gives what an
+// interleaved online run gives), and turns the result into the run folder's georeferenced files
+// (trajectory.tum, trajectory_lla.csv, georef.json) and report.json fields.
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "fusion/gnss_fusion.hpp"
+#include "fusion/gnss_screening.hpp"
+#include "io/dataset.hpp"
+
+namespace gvio::run {
+
+struct GnssRunResult {
+  fusion::FusionMode mode = fusion::FusionMode::kGraph;
+  fusion::Lla origin;  // of the local ENU frame
+  fusion::ScreeningCounts screening;
+  fusion::FusionStats stats;
+  Trajectory fused;  // T_enu_b, empty when the registration to ENU never succeeded
+  std::optional<Eigen::Isometry3d> T_enu_w;
+};
+
+// nullopt when the dataset has no usable fix (the run stays pure VIO). `origin` nullopt: the first
+// usable fix. `has_imu`: the VIO world is gravity-aligned (register yaw only), else full rotation.
+std::optional<GnssRunResult> fuseGnss(const io::Dataset& dataset, const Trajectory& vio,
+                                      fusion::FusionMode mode, fusion::FusionConfig config,
+                                      const std::optional<fusion::Lla>& origin, bool has_imu);
+
+// trajectory.tum (T_enu_b), trajectory_lla.csv (t, lat, lon, h, qw qx qy qz of the body in ENU) and
+// georef.json, all atomically.
+void writeGeoreferencedOutputs(const std::filesystem::path& out, const GnssRunResult& result);
+
+// report.json's "gnss" object and "outages" array.
+nlohmann::json gnssReport(const GnssRunResult& result, std::size_t fixes_in_dataset);
+nlohmann::json outagesReport(const GnssRunResult& result);
+
+}  // namespace gvio::run
