@@ -38,7 +38,7 @@ struct FusionConfig {
   // VIO relative-motion noise between consecutive nodes: drift per metre travelled plus a floor.
   double vio_drift_fraction = 0.004;
   double vio_sigma_floor_m = 0.02;
-  double vio_rot_drift_rad_per_m = 5e-5;
+  double vio_rot_drift_rad_per_m = 1e-5;
   double vio_rot_floor_rad = 5e-4;
   int window_nodes = 20;
   double huber_sigmas = 2.0;
