@@ -12,6 +12,10 @@
 
 namespace gvio::odometry {
 
+// False when the motion from `from` to `to` over dt_s is faster than a car-like platform moves or
+// turns (a failed solve or a wrong PnP, not motion).
+bool plausibleMotion(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to, double dt_s);
+
 // The latest estimate of any frame (also of non-keyframes, which leave the window).
 struct LatestState {
   bool valid = false;

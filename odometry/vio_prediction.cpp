@@ -1,0 +1,161 @@
+// Pose prediction for a new frame (IMU propagation, or constant velocity refined by PnP) and IMU
+// coasting through frames that cannot be estimated.
+#include <opencv2/calib3d.hpp>
+
+#include <algorithm>
+#include <string>
+
+#include "odometry/vio_estimator_impl.hpp"
+
+namespace gvio::odometry {
+namespace {
+
+// Coasting on the IMU alone longer than this drifts too far: the window restarts instead.
+constexpr double kMaxCoastS = 2.0;
+// A car-like platform does not move faster than this between frames, nor turn faster: an
+// estimate that does is a failed solve (a wrong PnP or a local minimum), not motion.
+constexpr double kMaxSpeedMps = 70.0;
+constexpr double kMaxTurnRateRadps = 2.0;
+// solvePnPRansac for the visual pose prediction.
+constexpr int kMinPnpPoints = 8;
+constexpr float kPnpReprojectionPx = 3.0F;
+
+}  // namespace
+
+bool plausibleMotion(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to, double dt_s) {
+  const double dt = std::max(dt_s, 0.01);
+  const double angle = Eigen::AngleAxisd(from.rotation().transpose() * to.rotation()).angle();
+  return (to.translation() - from.translation()).norm() <= kMaxSpeedMps * dt + 0.5 &&
+         angle <= kMaxTurnRateRadps * dt + 0.05;
+}
+
+FrameResult VioEstimator::Impl::coast(std::int64_t t_ns, const std::string& why) {
+  FrameResult r;
+  r.t_ns = t_ns;
+  ++counters.lost_frames;
+  const bool can_coast =
+      imuActive() && latest.valid &&
+      imu.covers(latest.t_ns, t_ns, static_cast<std::int64_t>(config.max_imu_gap_s * 1e9));
+  if (!can_coast) {
+    if (!window.frames().empty()) {
+      restart(t_ns, "lost", why + ": tracking lost, restarting at the last estimate", imuActive());
+    }
+    return r;
+  }
+  if (coast_start_ns < 0) {
+    coast_start_ns = t_ns;
+    event(t_ns, "coasting", why + ": propagating on the IMU alone");
+  }
+  auto pre = imu.preintegrate(latest.t_ns, t_ns, latest.bias, config.imu_noise);
+  const Eigen::Vector3d g(0, 0, -kGravity_mps2);
+  const double dt = pre->deltaT();
+  const Eigen::Matrix3d R = latest.T_w_b.rotation();
+  previous_pose = latest.T_w_b;
+  latest.T_w_b.translation() += latest.v_w * dt + 0.5 * g * dt * dt + R * pre->deltaP();
+  latest.v_w += g * dt + R * pre->deltaV();
+  latest.T_w_b.linear() = R * pre->deltaR();
+  latest.t_ns = t_ns;
+  ++counters.coasted_frames;
+  if (static_cast<double>(t_ns - coast_start_ns) * 1e-9 > kMaxCoastS) {
+    restart(t_ns, "reinitialized", "coasted longer than 2 s: window restarted at the IMU estimate",
+            true);
+  }
+  r.initialized = true;
+  r.T_w_b = latest.T_w_b;
+  r.v_w_mps = latest.v_w;
+  r.bias = latest.bias;
+  return r;
+}
+
+std::optional<Eigen::Isometry3d> VioEstimator::Impl::predictVisual(
+    const TrackedFrame& tracked) const {
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  const PoseLookup poses = window.poseLookup();
+  for (const Feature& f : tracked.features) {
+    auto it = window.landmarks().all().find(f.id);
+    if (it == window.landmarks().all().end() || !it->second.has_depth) continue;
+    const double* anchor = poses(it->second.anchor().frame_uid);
+    if (anchor == nullptr) continue;
+    const Eigen::Vector3d p_w = LandmarkMap::worldPoint(it->second, anchor, geometry);
+    object.emplace_back(p_w.x(), p_w.y(), p_w.z());
+    image.emplace_back(f.px_left.x(), f.px_left.y());
+  }
+  if (object.size() < static_cast<std::size_t>(kMinPnpPoints) || !latest.valid) return std::nullopt;
+  const double guess_dt_s = static_cast<double>(tracked.t_ns - latest.t_ns) * 1e-9;
+  // Initial guess: constant velocity from the last two estimates.
+  Eigen::Isometry3d guess = latest.T_w_b;
+  if (previous_pose) guess = latest.T_w_b * (previous_pose->inverse() * latest.T_w_b);
+  const Eigen::Isometry3d T_c_w = (guess * geometry.left.T_b_c).inverse();
+  cv::Mat K = (cv::Mat_<double>(3, 3) << geometry.left.fx, 0, geometry.left.cx, 0, geometry.left.fy,
+               geometry.left.cy, 0, 0, 1);
+  cv::Mat R_cv(3, 3, CV_64F), rvec, tvec(3, 1, CV_64F);
+  for (int r = 0; r < 3; ++r) {
+    tvec.at<double>(r) = T_c_w.translation()(r);
+    for (int c = 0; c < 3; ++c) R_cv.at<double>(r, c) = T_c_w.linear()(r, c);
+  }
+  cv::Rodrigues(R_cv, rvec);
+  std::vector<int> inliers;
+  const bool ok = cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, true, 100,
+                                     kPnpReprojectionPx, 0.99, inliers, cv::SOLVEPNP_ITERATIVE);
+  // A minority of inliers means RANSAC may have locked onto a wrong model: keep the guess.
+  if (!ok || inliers.size() < static_cast<std::size_t>(kMinPnpPoints) ||
+      2 * inliers.size() < object.size()) {
+    return guess;
+  }
+  cv::Rodrigues(rvec, R_cv);
+  Eigen::Isometry3d T_c_w_new = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    T_c_w_new.translation()(r) = tvec.at<double>(r);
+    for (int c = 0; c < 3; ++c) T_c_w_new.linear()(r, c) = R_cv.at<double>(r, c);
+  }
+  const Eigen::Isometry3d pnp = T_c_w_new.inverse() * geometry.left.T_b_c.inverse();
+  return plausibleMotion(latest.T_w_b, pnp, guess_dt_s) ? pnp : guess;
+}
+
+std::unique_ptr<WindowFrame> VioEstimator::Impl::predictFrame(std::int64_t t_ns,
+                                                              const TrackedFrame& tracked) {
+  auto f = std::make_unique<WindowFrame>();
+  f->uid = next_uid++;
+  f->t_ns = t_ns;
+  const auto max_hold = static_cast<std::int64_t>(config.max_imu_gap_s * 1e9);
+  const auto& frames = window.frames();
+  if (usesImu(config.mode) && !frames.empty() && imu.covers(frames.back()->t_ns, t_ns, max_hold)) {
+    const double gap = imu.largestGapS(frames.back()->t_ns, t_ns);
+    if (gap > config.max_imu_gap_s) {
+      ++counters.imu_gaps;
+      event(t_ns, "imu_gap", "IMU gap of " + std::to_string(gap) + " s bridged by interpolation");
+    }
+    f->preintegration =
+        imu.preintegrate(frames.back()->t_ns, t_ns, frames.back()->bias(), config.imu_noise);
+  } else if (usesImu(config.mode) && !frames.empty()) {
+    ++counters.imu_gaps;
+    event(t_ns, "imu_gap", "no IMU data up to this frame: visual constraints only");
+  }
+
+  if (imuActive() && latest.valid && imu.covers(latest.t_ns, t_ns, max_hold)) {
+    // IMU propagation of the latest state (Forster eq. 33).
+    auto pre = imu.preintegrate(latest.t_ns, t_ns, latest.bias, config.imu_noise);
+    const Eigen::Vector3d g(0, 0, -kGravity_mps2);
+    const double dt = pre->deltaT();
+    const Eigen::Matrix3d R = latest.T_w_b.rotation();
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = R * pre->deltaR();
+    T.translation() =
+        latest.T_w_b.translation() + latest.v_w * dt + 0.5 * g * dt * dt + R * pre->deltaP();
+    poseToBlock(T, f->pose.data());
+    f->velocity() = latest.v_w + g * dt + R * pre->deltaV();
+    f->setBias(latest.bias);
+    return f;
+  }
+  Eigen::Isometry3d T = latest.valid ? latest.T_w_b : Eigen::Isometry3d::Identity();
+  if (latest.valid) {
+    if (auto visual = predictVisual(tracked)) T = *visual;
+  }
+  poseToBlock(T, f->pose.data());
+  f->velocity() = latest.valid ? latest.v_w : Eigen::Vector3d::Zero();
+  f->setBias(latest.bias);
+  return f;
+}
+
+}  // namespace gvio::odometry
