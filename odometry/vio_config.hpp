@@ -33,7 +33,7 @@ struct EstimatorConfig {
   int keyframe_min_tracked = 50;       // fewer tracked landmarks than this makes a keyframe
   double pixel_sigma_px = 1.0;         // reprojection noise (1 sigma)
   double huber_sigmas = 2.0;           // robust (Huber) loss threshold in sigmas
-  int max_iterations = 5;              // Ceres iterations per frame (no wall-clock limit: the
+  int max_iterations = 4;              // Ceres iterations per frame (no wall-clock limit: the
                                        // estimator is deterministic)
   double min_depth_m = 0.5;            // landmarks closer or further are not used
   double max_depth_m = 80.0;

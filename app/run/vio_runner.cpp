@@ -53,8 +53,16 @@ class UnreadableImages {
   std::map<fs::path, Folder> folders_;
 };
 
+// Every event goes to report.json; the state changes a user watches for (waiting for motion,
+// initialised, lost, restarted) are also logged as they happen, the frequent ones at debug level.
 void appendEvents(odometry::VioEstimator& estimator, std::vector<odometry::VioEvent>& events) {
-  for (auto& e : estimator.takeEvents()) events.push_back(std::move(e));
+  for (auto& e : estimator.takeEvents()) {
+    const bool notable = e.kind == "waiting" || e.kind == "initialized" || e.kind == "lost" ||
+                         e.kind == "reinitialized" || e.kind == "time_jump" || e.kind == "coasting";
+    spdlog::log(notable ? spdlog::level::info : spdlog::level::debug, "vio {:.3f} s: {}: {}",
+                static_cast<double>(e.t_ns) * 1e-9, e.kind, e.message);
+    events.push_back(std::move(e));
+  }
 }
 
 }  // namespace

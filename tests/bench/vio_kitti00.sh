@@ -77,7 +77,7 @@ for mode in modes:
     g = rep.get("gnss", {})
     if fused:
         print(f'| {fused["rmse"]:.3f} | {g["used"]} / {g["rejected"]} '
-              f'| {g["ms_per_fix"]["mean"]:.2f} / {g["ms_per_fix"]["p95"]:.2f} |')
+              f'| {g["ms_per_fix"]["mean"]:.3f} / {g["ms_per_fix"]["p95"]:.3f} |')
     else:
         print("| - | - | - |")
 PY
