@@ -13,6 +13,8 @@
 #include <array>
 #include <cmath>
 
+#include "odometry/pnp.hpp"
+
 namespace gvio::odometry {
 namespace {
 
@@ -196,26 +198,10 @@ class Solver {
       image.emplace_back(u->x(), u->y());
     }
     if (static_cast<int>(object.size()) < std::max(o_.min_pnp_points, 6)) return false;
-    cv::Mat R_cv(3, 3, CV_64F), rvec, tvec(3, 1, CV_64F);
-    for (int r = 0; r < 3; ++r) {
-      tvec.at<double>(r) = guess.translation()(r);
-      for (int c = 0; c < 3; ++c) R_cv.at<double>(r, c) = guess.linear()(r, c);
-    }
-    cv::Rodrigues(R_cv, rvec);
-    std::vector<int> inliers;
-    const bool ok = cv::solvePnPRansac(
-        object, image, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), rvec, tvec, true, 100,
-        static_cast<float>(2.0 * o_.ransac_threshold_px / o_.focal_px), 0.99, inliers,
-        cv::SOLVEPNP_ITERATIVE);
-    if (!ok || static_cast<int>(inliers.size()) < std::max(o_.min_pnp_points, 6)) return false;
-    cv::Rodrigues(rvec, R_cv);
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    for (int r = 0; r < 3; ++r) {
-      T.translation()(r) = tvec.at<double>(r);
-      for (int c = 0; c < 3; ++c) T.linear()(r, c) = R_cv.at<double>(r, c);
-    }
-    if (!T.matrix().allFinite()) return false;
-    poses_[static_cast<std::size_t>(j)] = T;
+    const auto solved = pnpRansac(object, image, cv::Matx33d::eye(), guess,
+                                  static_cast<float>(2.0 * o_.ransac_threshold_px / o_.focal_px));
+    if (!solved || solved->inliers < std::max(o_.min_pnp_points, 6)) return false;
+    poses_[static_cast<std::size_t>(j)] = solved->T_c_w;
     return true;
   }
 

@@ -1,10 +1,9 @@
 // Pose prediction for a new frame (IMU propagation, or constant velocity refined by PnP) and IMU
 // coasting through frames that cannot be estimated.
-#include <opencv2/calib3d.hpp>
-
 #include <algorithm>
 #include <string>
 
+#include "odometry/pnp.hpp"
 #include "odometry/vio_estimator_impl.hpp"
 
 namespace gvio::odometry {
@@ -87,29 +86,15 @@ std::optional<Eigen::Isometry3d> VioEstimator::Impl::predictVisual(
   Eigen::Isometry3d guess = latest.T_w_b;
   if (previous_pose) guess = latest.T_w_b * (previous_pose->inverse() * latest.T_w_b);
   const Eigen::Isometry3d T_c_w = (guess * geometry.left.T_b_c).inverse();
-  cv::Mat K = (cv::Mat_<double>(3, 3) << geometry.left.fx, 0, geometry.left.cx, 0, geometry.left.fy,
-               geometry.left.cy, 0, 0, 1);
-  cv::Mat R_cv(3, 3, CV_64F), rvec, tvec(3, 1, CV_64F);
-  for (int r = 0; r < 3; ++r) {
-    tvec.at<double>(r) = T_c_w.translation()(r);
-    for (int c = 0; c < 3; ++c) R_cv.at<double>(r, c) = T_c_w.linear()(r, c);
-  }
-  cv::Rodrigues(R_cv, rvec);
-  std::vector<int> inliers;
-  const bool ok = cv::solvePnPRansac(object, image, K, cv::noArray(), rvec, tvec, true, 100,
-                                     kPnpReprojectionPx, 0.99, inliers, cv::SOLVEPNP_ITERATIVE);
+  const cv::Matx33d K(geometry.left.fx, 0, geometry.left.cx, 0, geometry.left.fy, geometry.left.cy,
+                      0, 0, 1);
+  const auto solved = pnpRansac(object, image, K, T_c_w, kPnpReprojectionPx);
   // A minority of inliers means RANSAC may have locked onto a wrong model: keep the guess.
-  if (!ok || inliers.size() < static_cast<std::size_t>(kMinPnpPoints) ||
-      2 * inliers.size() < object.size()) {
+  if (!solved || solved->inliers < kMinPnpPoints ||
+      2 * static_cast<std::size_t>(solved->inliers) < object.size()) {
     return guess;
   }
-  cv::Rodrigues(rvec, R_cv);
-  Eigen::Isometry3d T_c_w_new = Eigen::Isometry3d::Identity();
-  for (int r = 0; r < 3; ++r) {
-    T_c_w_new.translation()(r) = tvec.at<double>(r);
-    for (int c = 0; c < 3; ++c) T_c_w_new.linear()(r, c) = R_cv.at<double>(r, c);
-  }
-  const Eigen::Isometry3d pnp = T_c_w_new.inverse() * geometry.left.T_b_c.inverse();
+  const Eigen::Isometry3d pnp = solved->T_c_w.inverse() * geometry.left.T_b_c.inverse();
   return plausibleMotion(latest.T_w_b, pnp, guess_dt_s) ? pnp : guess;
 }
 
