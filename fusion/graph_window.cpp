@@ -27,12 +27,6 @@ void GraphWindow::addGnssFactor(GraphNode& node, std::shared_ptr<ceres::CostFunc
   node.unary.push_back(std::move(factor));
 }
 
-std::vector<double*> GraphWindow::priorBlocks() const {
-  std::vector<double*> blocks;
-  for (const auto& b : prior_->blocks) blocks.push_back(const_cast<double*>(b.original_address));
-  return blocks;
-}
-
 void GraphWindow::solve() {
   if (nodes_.empty()) return;
   ceres::Problem::Options popts;
@@ -53,7 +47,7 @@ void GraphWindow::solve() {
   }
   if (prior_) {
     prior_factor = std::make_shared<odometry::MarginalizationFactor>(prior_);
-    problem.AddResidualBlock(prior_factor.get(), nullptr, priorBlocks());
+    problem.AddResidualBlock(prior_factor.get(), nullptr, prior_->blockAddresses());
   }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
@@ -73,7 +67,7 @@ void GraphWindow::marginalizeOldest() {
   bool named = false;
   if (prior_) {
     m.addResidualBlock(std::make_shared<odometry::MarginalizationFactor>(prior_), nullptr,
-                       priorBlocks());
+                       prior_->blockAddresses());
     named = prior_->blockIndex(oldest.pose.data()) >= 0;
   }
   for (const auto& f : oldest.unary) {

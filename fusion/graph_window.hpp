@@ -48,7 +48,6 @@ class GraphWindow {
 
  private:
   void marginalizeOldest();
-  std::vector<double*> priorBlocks() const;
 
   int max_nodes_;
   int max_iterations_;

@@ -87,6 +87,14 @@ int MarginalizationPrior::tangentSize() const {
   return n;
 }
 
+std::vector<double*> MarginalizationPrior::blockAddresses() const {
+  std::vector<double*> addresses;
+  addresses.reserve(blocks.size());
+  // The prior only reads its blocks; Ceres' interface takes them as mutable.
+  for (const Block& b : blocks) addresses.push_back(const_cast<double*>(b.original_address));
+  return addresses;
+}
+
 int MarginalizationPrior::blockIndex(const double* original_address) const {
   for (std::size_t i = 0; i < blocks.size(); ++i) {
     if (blocks[i].original_address == original_address) return static_cast<int>(i);

@@ -46,6 +46,9 @@ struct MarginalizationPrior {
   [[nodiscard]] int tangentSize() const;
   // H* = J^T J, the information the prior holds on the kept blocks' tangent spaces.
   [[nodiscard]] Eigen::MatrixXd information() const { return J.transpose() * J; }
+  // The kept blocks' addresses in `blocks` order: the parameter blocks of a MarginalizationFactor
+  // for an estimator whose blocks do not move.
+  [[nodiscard]] std::vector<double*> blockAddresses() const;
   // Index into `blocks` of the block marginalised at `original_address`, or -1.
   [[nodiscard]] int blockIndex(const double* original_address) const;
 };

@@ -143,9 +143,7 @@ SolveStats SlidingWindow::solve(bool use_imu) {
     }
   }
   if (prior_) {
-    std::vector<double*> blocks;
-    for (const auto& b : prior_->blocks) blocks.push_back(const_cast<double*>(b.original_address));
-    add(std::make_shared<MarginalizationFactor>(prior_), nullptr, blocks);
+    add(std::make_shared<MarginalizationFactor>(prior_), nullptr, prior_->blockAddresses());
   }
   bool anchored = false;
   for (const AnchorFactor& a : anchors_) {
@@ -188,11 +186,8 @@ void SlidingWindow::marginalizeOldest(bool use_imu) {
     // A block may only be marked when some residual names it.
     bool pose_named = false, speed_bias_named = false;
     if (prior_) {
-      std::vector<double*> blocks;
-      for (const auto& b : prior_->blocks) {
-        blocks.push_back(const_cast<double*>(b.original_address));
-      }
-      m.addResidualBlock(std::make_shared<MarginalizationFactor>(prior_), nullptr, blocks);
+      m.addResidualBlock(std::make_shared<MarginalizationFactor>(prior_), nullptr,
+                         prior_->blockAddresses());
       pose_named = prior_->blockIndex(oldest.pose.data()) >= 0;
       speed_bias_named = prior_->blockIndex(oldest.speed_bias.data()) >= 0;
     }
