@@ -127,18 +127,25 @@ bool VioEstimator::Impl::isKeyframe(const WindowFrame& f, const TrackedFrame& tr
   if (frames.empty()) return true;
   const WindowFrame& last_kf = *frames.back();
   if (static_cast<double>(f.t_ns - last_kf.t_ns) * 1e-9 >= kMaxKeyframeIntervalS) return true;
-  int tracked_landmarks = 0;
-  double parallax_sum = 0.0;
+  const Parallax parallax = parallaxTo(tracked, last_kf.uid);
+  if (parallax.count < config.keyframe_min_tracked) return true;
+  return parallax.mean_px >= config.keyframe_parallax_px;
+}
+
+VioEstimator::Impl::Parallax VioEstimator::Impl::parallaxTo(const TrackedFrame& tracked,
+                                                            std::uint64_t frame_uid) const {
+  Parallax p;
+  double sum_px = 0.0;
   for (const Feature& feat : tracked.features) {
     auto it = window.landmarks().all().find(feat.id);
     if (it == window.landmarks().all().end()) continue;
-    const Observation* o = it->second.in(last_kf.uid);
+    const Observation* o = it->second.in(frame_uid);
     if (o == nullptr) continue;
-    ++tracked_landmarks;
-    parallax_sum += (feat.px_left - o->px_left).norm();
+    ++p.count;
+    sum_px += (feat.px_left - o->px_left).norm();
   }
-  if (tracked_landmarks < config.keyframe_min_tracked) return true;
-  return parallax_sum / tracked_landmarks >= config.keyframe_parallax_px;
+  if (p.count > 0) p.mean_px = sum_px / p.count;
+  return p;
 }
 
 void VioEstimator::Impl::addObservations(const WindowFrame& f, const TrackedFrame& tracked) {

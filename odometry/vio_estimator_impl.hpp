@@ -36,6 +36,13 @@ struct VioEstimator::Impl {
   std::unique_ptr<WindowFrame> predictFrame(std::int64_t t_ns, const TrackedFrame& tracked);
   std::optional<Eigen::Isometry3d> predictVisual(const TrackedFrame& tracked) const;
   bool isKeyframe(const WindowFrame& f, const TrackedFrame& tracked) const;
+  // The features of `tracked` that are window landmarks seen in frame `frame_uid`, and their mean
+  // image motion since then (keyframe parallax, static detection).
+  struct Parallax {
+    int count = 0;
+    double mean_px = 0.0;
+  };
+  [[nodiscard]] Parallax parallaxTo(const TrackedFrame& tracked, std::uint64_t frame_uid) const;
   void addObservations(const WindowFrame& f, const TrackedFrame& tracked);
   void finishFrame(const WindowFrame& f);
   // Restarts the window at the latest estimate (lost tracking, long coasting, time jumps).

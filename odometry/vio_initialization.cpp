@@ -70,18 +70,10 @@ bool VioEstimator::Impl::staticInitialize(std::int64_t t_ns, const TrackedFrame&
     return false;
   }
   // Image motion against the oldest window frame.
-  const WindowFrame& oldest = *frames.front();
-  double motion = 0.0;
-  int n = 0;
-  for (const Feature& feat : tracked.features) {
-    auto it = window.landmarks().all().find(feat.id);
-    if (it == window.landmarks().all().end()) continue;
-    const Observation* o = it->second.in(oldest.uid);
-    if (o == nullptr) continue;
-    motion += (feat.px_left - o->px_left).norm();
-    ++n;
+  const Parallax motion = parallaxTo(tracked, frames.front()->uid);
+  if (motion.count < kMinStaticFeatures || motion.mean_px > config.static_pixel_motion_px) {
+    return false;
   }
-  if (n < kMinStaticFeatures || motion / n > config.static_pixel_motion_px) return false;
 
   // Standing still, the accelerometer measures -R_w_b^T g: the body's "up" is the mean specific
   // force; the gyroscope's mean is its bias.
