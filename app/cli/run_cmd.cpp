@@ -7,7 +7,6 @@
 #include <filesystem>
 
 #include "cli/app.hpp"
-#include "eval/evaluate.hpp"
 #include "io/atomic_write.hpp"
 #include "io/trajectory_io.hpp"
 #include "odometry/error.hpp"
@@ -36,25 +35,6 @@ void checkGnssOption(const std::string& gnss) {
   }
 }
 
-// The fused trajectory against the ground truth with no alignment at all: both must be in the same
-// local ENU frame (fusion.origin set to the truth's origin, as for simulated drives).
-nlohmann::json evaluateFused(const Trajectory& truth, const Trajectory& fused) {
-  try {
-    eval::EvalOptions options;
-    options.align = eval::Alignment::kNone;
-    const eval::EvalResult r = eval::evaluate(truth, fused, options);
-    return {{"ape_none",
-             {{"rmse", r.ape_stats.rmse},
-              {"mean", r.ape_stats.mean},
-              {"median", r.ape_stats.median},
-              {"max", r.ape_stats.max},
-              {"n", r.ape.size()}}},
-            {"note", "no alignment, in the ENU frame of fusion.origin (the truth's must match)"}};
-  } catch (const InvalidInput& e) {
-    return {{"error", e.what()}};
-  }
-}
-
 void makeOutputDir(const fs::path& out) {
   std::error_code ec;
   fs::create_directories(out, ec);
@@ -78,13 +58,13 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
   estimator.validate();
   const fs::path out = opt.out;
   makeOutputDir(out);
-  std::optional<fusion::FusionMode> gnss_mode;
-  if (opt.gnss == "kf" || opt.gnss == "graph") gnss_mode = fusion::parseFusionMode(opt.gnss);
-  if (opt.gnss == "auto" && !ds.gnss.empty()) gnss_mode = fusion::FusionMode::kGraph;
-  if (gnss_mode && ds.gnss.empty()) {
+  // auto fuses with the graph when the dataset has fixes; without fixes every mode is pure VIO.
+  const bool fuse_gnss = opt.gnss != "off" && !ds.gnss.empty();
+  if (!fuse_gnss && (opt.gnss == "kf" || opt.gnss == "graph")) {
     spdlog::warn("--gnss {}: the dataset has no GNSS fixes: pure VIO", opt.gnss);
-    gnss_mode.reset();
   }
+  const fusion::FusionMode gnss_mode =
+      opt.gnss == "kf" ? fusion::FusionMode::kKf : fusion::FusionMode::kGraph;
   spdlog::info("{} {} ({}): {} frames, mode {}", io::toString(ds.format), ds.root.string(),
                ds.variant, ds.frames.size(), odometry::toString(estimator.mode));
 
@@ -109,8 +89,8 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
     if (!evaluation->result) spdlog::warn("no evaluation: {}", evaluation->error);
   }
   std::optional<run::GnssRunResult> gnss;
-  if (gnss_mode) {
-    gnss = run::fuseGnss(ds, result.trajectory, *gnss_mode, config.fusion.fusion,
+  if (fuse_gnss) {
+    gnss = run::fuseGnss(ds, result.trajectory, gnss_mode, config.fusion.fusion,
                          config.fusion.originLla(), odometry::usesImu(estimator.mode));
     if (gnss) run::writeGeoreferencedOutputs(out, *gnss);
   }
@@ -121,18 +101,15 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
     context.imu_noise_source = dataset_noise ? "dataset" : "config";
   context.peak_rss_mb = run::peakRssMb();
   context.evaluation = evaluation ? &*evaluation : nullptr;
-  nlohmann::json report = run::buildReport(ds, result, context);
-  if (gnss) {
-    report["gnss"] = run::gnssReport(*gnss, ds.gnss.size());
-    report["gnss"]["requested"] = opt.gnss;
-    report["outages"] = run::outagesReport(*gnss);
-    // Without alignment the truth must be in the same ENU frame: only with an explicit origin.
-    if (ds.groundtruth && ds.groundtruth->hasTimestamps() && !gnss->fused.empty() &&
-        config.fusion.originLla()) {
-      report["evaluation_fused"] = evaluateFused(*ds.groundtruth, gnss->fused);
-    }
+  context.gnss = gnss ? &*gnss : nullptr;
+  // Without alignment the truth must be in the same ENU frame: only with an explicit origin.
+  std::optional<run::UnalignedOutcome> evaluation_fused;
+  if (gnss && ds.groundtruth && ds.groundtruth->hasTimestamps() && !gnss->fused.empty() &&
+      config.fusion.originLla()) {
+    evaluation_fused = run::evaluateUnaligned(*ds.groundtruth, gnss->fused);
   }
-  io::writeTextAtomic(out / "report.json", report.dump(2) + "\n");
+  context.evaluation_fused = evaluation_fused ? &*evaluation_fused : nullptr;
+  io::writeTextAtomic(out / "report.json", run::buildReport(ds, result, context).dump(2) + "\n");
   io::writeTextAtomic(out / "config.yaml", dumpConfigYaml(config));
 
   const run::TimingSummary total = run::summarizeTimings(result.timings.total_ms);
@@ -145,9 +122,9 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
   }
   if (gnss) {
     std::string fused_ape;
-    if (report.contains("evaluation_fused") && report["evaluation_fused"].contains("ape_none")) {
-      fused_ape = fmt::format(", fused APE (no alignment) rmse {:.3f} m",
-                              report["evaluation_fused"]["ape_none"]["rmse"].get<double>());
+    if (evaluation_fused && evaluation_fused->ape) {
+      fused_ape =
+          fmt::format(", fused APE (no alignment) rmse {:.3f} m", evaluation_fused->ape->rmse);
     }
     spdlog::info("GNSS {}: {} fixes used, {} rejected, {} skipped, {} outage(s){}",
                  fusion::toString(gnss->mode), gnss->stats.fixes_used, gnss->stats.fixes_rejected,

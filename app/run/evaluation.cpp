@@ -39,4 +39,16 @@ EvaluationOutcome evaluateAgainstTruth(const Trajectory& truth, const Trajectory
   return out;
 }
 
+UnalignedOutcome evaluateUnaligned(const Trajectory& truth, const Trajectory& estimate) {
+  UnalignedOutcome out;
+  eval::EvalOptions options;
+  options.align = eval::Alignment::kNone;
+  try {
+    out.ape = eval::evaluate(truth, estimate, options).ape_stats;
+  } catch (const InvalidInput& e) {
+    out.error = e.what();
+  }
+  return out;
+}
+
 }  // namespace gvio::run

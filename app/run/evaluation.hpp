@@ -27,4 +27,13 @@ struct EvaluationOutcome {
 // `truth` and `estimate` need timestamps; poses associate within 10 ms as evo's default.
 EvaluationOutcome evaluateAgainstTruth(const Trajectory& truth, const Trajectory& estimate);
 
+struct UnalignedOutcome {
+  std::optional<eval::Stats> ape;  // translation APE (m) with no alignment at all
+  std::string error;               // why there is none, else ""
+};
+
+// The fused trajectory against the truth as they are: both must be in the same frame (the local
+// ENU frame of fusion.origin set to the truth's origin, as for simulated drives).
+UnalignedOutcome evaluateUnaligned(const Trajectory& truth, const Trajectory& estimate);
+
 }  // namespace gvio::run

@@ -67,18 +67,33 @@ json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportCon
                          {"total", timingJson(run.timings.total_ms)}};
   report["wall_s"] = run.wall_s;
   report["peak_rss_mb"] = ctx.peak_rss_mb;
-  report["gnss"] = {{"requested", ctx.gnss_requested},
-                    {"mode", "off"},
-                    {"fixes", run.gnss_fixes},
-                    {"used", 0},
-                    {"rejected", 0}};
-  report["outages"] = json::array();
+  if (ctx.gnss) {
+    report["gnss"] = gnssReport(*ctx.gnss, ds.gnss.size());
+    report["gnss"]["requested"] = ctx.gnss_requested;
+    report["outages"] = outagesReport(*ctx.gnss);
+  } else {
+    report["gnss"] = {{"requested", ctx.gnss_requested},
+                      {"mode", "off"},
+                      {"fixes", run.gnss_fixes},
+                      {"used", 0},
+                      {"rejected", 0}};
+    report["outages"] = json::array();
+  }
   json events = json::array();
   for (const odometry::VioEvent& e : run.events) {
     events.push_back({{"t", seconds(e.t_ns)}, {"kind", e.kind}, {"message", e.message}});
   }
   report["events"] = std::move(events);
   if (ctx.evaluation) report["evaluation"] = evaluationJson(*ctx.evaluation);
+  if (ctx.evaluation_fused) {
+    const UnalignedOutcome& e = *ctx.evaluation_fused;
+    report["evaluation_fused"] =
+        e.ape ? json{{"ape_none", statsJson(*e.ape)},
+                     {"note",
+                      "no alignment, in the ENU frame of fusion.origin (the truth's must "
+                      "match)"}}
+              : json{{"error", e.error}};
+  }
   return report;
 }
 

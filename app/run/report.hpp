@@ -7,6 +7,7 @@
 
 #include "io/dataset.hpp"
 #include "run/evaluation.hpp"
+#include "run/gnss_run.hpp"
 #include "run/vio_runner.hpp"
 
 namespace gvio::run {
@@ -16,7 +17,9 @@ struct ReportContext {
   std::string gnss_requested = "off";  // the --gnss value as given
   std::string imu_noise_source;        // "dataset" or "config"; empty when the mode has no IMU
   double peak_rss_mb = 0.0;
-  const EvaluationOutcome* evaluation = nullptr;  // null: the dataset has no ground truth
+  const EvaluationOutcome* evaluation = nullptr;       // null: the dataset has no ground truth
+  const GnssRunResult* gnss = nullptr;                 // null: no GNSS fusion ran
+  const UnalignedOutcome* evaluation_fused = nullptr;  // null: not evaluated
 };
 
 nlohmann::json buildReport(const io::Dataset& dataset, const VioRunResult& run,
