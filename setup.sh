@@ -13,7 +13,7 @@ JOBS="${JOBS:-$(nproc)}"
 
 PACKAGES=(
   g++ cmake ninja-build pkg-config clang-format
-  libeigen3-dev libceres-dev libopencv-dev libpcl-dev liboctomap-dev
+  libeigen3-dev libceres-dev libopencv-dev libpcl-dev liboctomap-dev libgdal-dev
   libegl-dev libgl-dev libepoxy-dev libegl-mesa0 libgl1-mesa-dri
   libgeographiclib-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
   nlohmann-json3-dev libcairo2-dev zlib1g-dev libgtest-dev libgmock-dev libbenchmark-dev

@@ -9,6 +9,8 @@ set(CMAKE_DISABLE_FIND_PACKAGE_VTK ON)
 find_package(PCL REQUIRED COMPONENTS common io filters kdtree)
 unset(CMAKE_DISABLE_FIND_PACKAGE_VTK)
 find_package(octomap REQUIRED)
+# GDAL/OGR: GeoJSON, KML and GPX exports and the WKT of UTM coordinate systems (LAS).
+find_package(GDAL CONFIG REQUIRED)
 find_package(yaml-cpp REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(fmt REQUIRED)

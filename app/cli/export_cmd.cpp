@@ -1,0 +1,45 @@
+// gvio export: one file of a run folder in another format (app/export/run_export.hpp).
+#include <spdlog/spdlog.h>
+
+#include "cli/app.hpp"
+#include "export/run_export.hpp"
+#include "odometry/error.hpp"
+
+namespace gvio::cli {
+namespace {
+
+struct ExportCliOptions {
+  std::string run, to;
+  std::optional<std::string> out;
+};
+
+int runExport(const ExportCliOptions& o) {
+  // Checked here rather than with CLI11's IsMember, whose failure message takes two lines.
+  const auto format = exporter::parseExportFormat(o.to);
+  if (!format) {
+    throw InvalidInput("--to '" + o.to + "': unknown format; one of " +
+                       exporter::exportFormatList());
+  }
+  const std::filesystem::path out =
+      o.out ? std::filesystem::path(*o.out) : exporter::defaultExportPath(o.run, *format);
+  const exporter::ExportResult r = exporter::exportRun(o.run, *format, out);
+  for (const auto& file : r.written) spdlog::info("wrote {}", file.string());
+  spdlog::info("{} {} from {}", r.count, r.what, r.source.string());
+  return 0;
+}
+
+}  // namespace
+
+Command addExportCommand(CLI::App& app) {
+  auto o = std::make_shared<ExportCliOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "export",
+      "Write a run's map or trajectory as PCD, PLY, LAS, OctoMap, TUM/KITTI/EuRoC or "
+      "GeoJSON/KML/GPX");
+  sub->add_option("--run", o->run, "Run folder (the --out of gvio run)")->required();
+  sub->add_option("--to", o->to, exporter::exportFormatList())->required();
+  sub->add_option("--out", o->out, "Output file (default: RUN/export.<ext>)");
+  return {sub, [o] { return runExport(*o); }};
+}
+
+}  // namespace gvio::cli

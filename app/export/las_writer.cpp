@@ -1,0 +1,217 @@
+#include "export/las_writer.hpp"
+
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "export/gdal_support.hpp"
+#include "io/atomic_write.hpp"
+#include "odometry/error.hpp"
+
+namespace gvio::exporter {
+namespace {
+
+// LAS is little-endian throughout; the writer copies host values byte for byte.
+static_assert(std::endian::native == std::endian::little,
+              "LAS writer assumes a little-endian host");
+
+constexpr std::uint16_t kHeaderSize = 375;  // LAS 1.4 public header block
+constexpr std::uint16_t kVlrHeaderSize = 54;
+constexpr std::uint8_t kPointFormat = 6;  // X Y Z, intensity, returns, class, GPS time
+constexpr std::uint16_t kPointSize = 30;
+// Bit 0: GPS times are adjusted standard GPS time (they are all 0 here: a map point aggregates many
+// keyframes); bit 3: return numbers are synthetic (not a lidar); bit 4: the CRS is OGC WKT, which
+// point formats 6-10 require (GeoTIFF keys are not allowed with them).
+constexpr std::uint16_t kGlobalEncoding = 0x1 | 0x8 | 0x10;
+constexpr std::uint16_t kWktRecordId = 2112;  // "OGC Coordinate System WKT"
+constexpr double kFalseNorthingSouthM = 10'000'000.0;
+
+class Bytes {
+ public:
+  template <typename T>
+  void put(T value) {
+    char raw[sizeof(T)];
+    std::memcpy(raw, &value, sizeof(T));
+    data_.append(raw, sizeof(T));
+  }
+  // A fixed-width character field, null padded (and truncated to leave at least one null).
+  void putText(std::string_view text, std::size_t width) {
+    const std::size_t n = std::min(text.size(), width - 1);
+    data_.append(text.substr(0, n));
+    data_.append(width - n, '\0');
+  }
+  void putZeros(std::size_t n) { data_.append(n, '\0'); }
+  [[nodiscard]] const std::string& data() const { return data_; }
+  void clear() { data_.clear(); }
+
+ private:
+  std::string data_;
+};
+
+struct Quantized {
+  double scale = 0.001;
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Matrix<std::int32_t, 3, 1>> xyz;
+  Eigen::Vector3d min = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();
+};
+
+// Offsets at the centre of the data, rounded to whole metres, keep the 32-bit records small and
+// the stored coordinates exact multiples of the scale.
+Quantized quantize(const std::vector<Eigen::Vector3d>& utm, double scale) {
+  Quantized q;
+  q.scale = scale;
+  if (utm.empty()) return q;
+  Eigen::Vector3d lo = utm.front(), hi = utm.front();
+  for (const auto& p : utm) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  q.offset = (0.5 * (lo + hi)).array().round();
+  q.xyz.reserve(utm.size());
+  constexpr double kMax = std::numeric_limits<std::int32_t>::max();
+  for (const auto& p : utm) {
+    const Eigen::Vector3d steps = ((p - q.offset) / scale).array().round();
+    if (!steps.allFinite() || steps.cwiseAbs().maxCoeff() > kMax) {
+      throw InvalidInput("LAS: map spans more than the 32-bit coordinate grid holds at scale " +
+                         std::to_string(scale) + " m");
+    }
+    q.xyz.push_back(steps.cast<std::int32_t>());
+  }
+  const auto stored = [&q](const Eigen::Matrix<std::int32_t, 3, 1>& r) -> Eigen::Vector3d {
+    return r.cast<double>() * q.scale + q.offset;
+  };
+  q.min = q.max = stored(q.xyz.front());
+  for (const auto& r : q.xyz) {
+    q.min = q.min.cwiseMin(stored(r));
+    q.max = q.max.cwiseMax(stored(r));
+  }
+  return q;
+}
+
+std::pair<std::uint16_t, std::uint16_t> todayDayOfYearAndYear() {
+  using namespace std::chrono;
+  const sys_days today = floor<days>(system_clock::now());
+  const year_month_day ymd(today);
+  const sys_days jan1 = ymd.year() / January / 1;
+  return {static_cast<std::uint16_t>((today - jan1).count() + 1),
+          static_cast<std::uint16_t>(static_cast<int>(ymd.year()))};
+}
+
+std::string header(const Quantized& q, std::uint64_t n, std::uint32_t offset_to_points) {
+  Bytes b;
+  for (const char c : std::string_view("LASF")) b.put(c);  // 4 characters, no terminator
+  b.put<std::uint16_t>(0);  // file source ID: an aggregate map, none assigned
+  b.put(kGlobalEncoding);
+  b.putZeros(16);  // project GUID
+  b.put<std::uint8_t>(1);
+  b.put<std::uint8_t>(4);
+  b.putText("OTHER", 32);  // system identifier for software-generated data
+  b.putText(std::string("gvio ") + GVIO_VERSION, 32);
+  const auto [day, year] = todayDayOfYearAndYear();
+  b.put(day);
+  b.put(year);
+  b.put(kHeaderSize);
+  b.put(offset_to_points);
+  b.put<std::uint32_t>(1);  // VLRs
+  b.put(kPointFormat);
+  b.put(kPointSize);
+  // Legacy point counts must be 0 for point formats >= 6 (LAS 1.4 R15, "Legacy Number of Point
+  // Records"): readers take the 64-bit counts below.
+  b.putZeros(4 + 5 * 4);
+  for (int i = 0; i < 3; ++i) b.put(q.scale);
+  for (int i = 0; i < 3; ++i) b.put(q.offset[i]);
+  for (int i = 0; i < 3; ++i) {
+    b.put(q.max[i]);
+    b.put(q.min[i]);
+  }
+  b.put<std::uint64_t>(0);  // no waveform data
+  b.put<std::uint64_t>(0);  // no EVLRs
+  b.put<std::uint32_t>(0);
+  b.put(n);
+  b.put(n);  // every point is a first (and only) return
+  b.putZeros(14 * 8);
+  if (b.data().size() != kHeaderSize) throw std::logic_error("LAS header layout");
+  return b.data();
+}
+
+std::string wktVlr(const std::string& wkt) {
+  Bytes b;
+  b.put<std::uint16_t>(0);
+  b.putText("LASF_Projection", 16);
+  b.put(kWktRecordId);
+  b.put(static_cast<std::uint16_t>(wkt.size() + 1));  // the WKT is null-terminated
+  b.putText("OGC WKT coordinate system", 32);
+  if (b.data().size() != kVlrHeaderSize) throw std::logic_error("LAS VLR header layout");
+  return b.data() + wkt + '\0';
+}
+
+void putPoint(Bytes& b, const Eigen::Matrix<std::int32_t, 3, 1>& xyz, const LasPoint& p) {
+  b.put(xyz.x());
+  b.put(xyz.y());
+  b.put(xyz.z());
+  b.put(p.intensity);
+  b.put<std::uint8_t>(0x11);  // return 1 of 1
+  b.put<std::uint8_t>(0);     // classification flags, channel, scan direction, edge
+  b.put(p.classification);
+  b.put<std::uint8_t>(0);   // user data
+  b.put<std::int16_t>(0);   // scan angle
+  b.put<std::uint16_t>(0);  // point source ID
+  b.put(0.0);               // GPS time
+}
+
+}  // namespace
+
+Eigen::Vector3d enuToUtm(const fusion::EnuFrame& enu, const Eigen::Vector3d& p_enu, int zone,
+                         bool north) {
+  const fusion::Lla lla = enu.toLla(p_enu);
+  const fusion::Utm utm = fusion::llaToUtm(lla, zone);
+  double northing = utm.northing_m;
+  if (utm.north && !north) northing += kFalseNorthingSouthM;
+  if (!utm.north && north) northing -= kFalseNorthingSouthM;
+  return {utm.easting_m, northing, lla.h_ellipsoid_m};
+}
+
+LasSummary writeLas(const std::filesystem::path& file, const fusion::Lla& enu_origin,
+                    std::span<const LasPoint> points, const LasOptions& options) {
+  if (!(options.scale_m > 0.0)) throw InvalidInput("LAS: scale must be positive");
+  LasSummary summary;
+  summary.crs = options.utm_zone ? fusion::llaToUtm(enu_origin, *options.utm_zone)
+                                 : fusion::llaToUtm(enu_origin);
+  if (options.utm_north) summary.crs.north = *options.utm_north;
+  const std::string wkt = wktFromEpsg(summary.crs.epsg());
+
+  const fusion::EnuFrame enu(enu_origin);
+  std::vector<Eigen::Vector3d> utm;
+  utm.reserve(points.size());
+  for (const LasPoint& p : points) {
+    utm.push_back(enuToUtm(enu, p.p_enu, summary.crs.zone, summary.crs.north));
+  }
+  const Quantized q = quantize(utm, options.scale_m);
+  summary.points = points.size();
+  summary.min = q.min;
+  summary.max = q.max;
+
+  const std::string vlr = wktVlr(wkt);
+  const auto offset_to_points = static_cast<std::uint32_t>(kHeaderSize + vlr.size());
+  io::writeFileAtomic(file, [&](std::ostream& out) {
+    out << header(q, summary.points, offset_to_points) << vlr;
+    Bytes chunk;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      putPoint(chunk, q.xyz[i], points[i]);
+      if (chunk.data().size() >= (1u << 20)) {
+        out << chunk.data();
+        chunk.clear();
+      }
+    }
+    out << chunk.data();
+  });
+  return summary;
+}
+
+}  // namespace gvio::exporter

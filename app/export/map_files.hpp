@@ -1,0 +1,41 @@
+#pragma once
+// The run folder's map files read generically and written again: the point cloud (map.pcd /
+// map.ply, any fields, through PCL) and the OctoMap occupancy (map.bt / map.ot). Reading them back
+// through their own libraries is what validates them before an export.
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <pcl/PCLPointCloud2.h>
+
+#include "export/las_writer.hpp"
+
+namespace gvio::exporter {
+
+// map.pcd or map.ply (by extension). Throws InputError naming `file` when it is missing,
+// unreadable, has no float x/y/z fields, or holds 0 points.
+pcl::PCLPointCloud2 readPointCloud2(const std::filesystem::path& file);
+
+// PCD binary compressed / PLY binary (every field kept), written atomically.
+void writePcd(const std::filesystem::path& file, const pcl::PCLPointCloud2& cloud);
+void writePly(const std::filesystem::path& file, const pcl::PCLPointCloud2& cloud);
+
+// The cloud's finite x/y/z (ENU) with its "intensity" field, when present, scaled to LAS's 16-bit
+// range by the field's type: 8-bit x 257, 16-bit as is, floats in [0, 1] x 65535, floats up to
+// 255 x 257, anything else clamped.
+std::vector<LasPoint> lasPoints(const pcl::PCLPointCloud2& cloud);
+
+struct OctreeSummary {
+  std::string type;  // "OcTree", "ColorOcTree", ...
+  double resolution_m = 0.0;
+  std::size_t nodes = 0, leaves = 0;
+};
+
+// Reads an OctoMap file and writes it again atomically: .bt (OcTree binary, readBinary /
+// writeBinary) or .ot (any AbstractOcTree, read / write). Throws InputError naming the input when
+// it is missing, not an OctoMap file of that kind, or empty, and naming `out` when unwritable.
+OctreeSummary copyOctreeBinary(const std::filesystem::path& in, const std::filesystem::path& out);
+OctreeSummary copyOctreeFull(const std::filesystem::path& in, const std::filesystem::path& out);
+
+}  // namespace gvio::exporter
