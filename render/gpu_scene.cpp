@@ -1,6 +1,7 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <unordered_set>
 
 #include "render/render_error.hpp"
 #include "render/renderer.hpp"
@@ -78,6 +79,45 @@ std::vector<float> unitCube() {
     }
   }
   return v;
+}
+
+// Per voxel, a bit per cube face (unitCube's order: +x -x +y -y +z -z) set where the set holds the
+// lattice neighbour on that side: the face is inside an opaque solid and never seen. Voxels off
+// the lattice of the first centre (spacing size_m) take part in nothing. A ground slab of voxels
+// then sends one face per voxel to the rasteriser instead of three.
+std::vector<float> hiddenFaces(const VoxelSet& set) {
+  const Eigen::Vector3d origin = set.centers.front();
+  auto latticeKey = [&](const Eigen::Vector3d& c, std::uint64_t& key) {
+    const Eigen::Vector3d f = (c - origin) / set.size_m;
+    const Eigen::Vector3d r = f.array().round();
+    if ((f - r).cwiseAbs().maxCoeff() > 1e-3 || r.cwiseAbs().maxCoeff() >= (1 << 20)) return false;
+    key = 0;
+    for (int a = 0; a < 3; ++a) {
+      key = key << 21U |
+            (static_cast<std::uint64_t>(static_cast<std::int64_t>(r[a]) + (1 << 20)) & 0x1FFFFFU);
+    }
+    return true;
+  };
+  std::unordered_set<std::uint64_t> occupied;
+  occupied.reserve(set.centers.size());
+  std::uint64_t key = 0;
+  for (const auto& c : set.centers) {
+    if (latticeKey(c, key)) occupied.insert(key);
+  }
+  static const int kStep[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                  {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+  std::vector<float> hidden(set.centers.size(), 0.0F);
+  for (std::size_t i = 0; i < set.centers.size(); ++i) {
+    if (!latticeKey(set.centers[i], key)) continue;
+    int bits = 0;
+    for (int f = 0; f < 6; ++f) {
+      const Eigen::Vector3d n =
+          set.centers[i] + set.size_m * Eigen::Vector3d(kStep[f][0], kStep[f][1], kStep[f][2]);
+      if (latticeKey(n, key) && occupied.count(key) != 0) bits |= 1 << f;
+    }
+    hidden[i] = static_cast<float>(bits);
+  }
+  return hidden;
 }
 
 }  // namespace
@@ -178,12 +218,16 @@ void GpuScene::uploadVoxels(const Scene& scene) {
       glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(cube.size() * sizeof(float)),
                    cube.data(), GL_STATIC_DRAW);
     }
+    // Per instance: centre (3), colour (4), hidden-face bits (1, a float the shader truncates).
+    const std::vector<float> hidden = hiddenFaces(set);
     std::vector<float> inst;
-    inst.reserve(set.centers.size() * 7);
+    inst.reserve(set.centers.size() * 8);
     for (std::size_t i = 0; i < set.centers.size(); ++i) {
       const Eigen::Vector3f c = (set.centers[i] - origin_).cast<float>();
       const Color col = pick(set.colors, i, set.centers.size(), kLightGrey, "voxel colours");
-      inst.insert(inst.end(), {c.x(), c.y(), c.z(), col[0], col[1], col[2], col[3]});
+      // A see-through voxel shows its inner faces: hide faces between opaque ones only.
+      const float h = col[3] >= 1.0F ? hidden[i] : 0.0F;
+      inst.insert(inst.end(), {c.x(), c.y(), c.z(), col[0], col[1], col[2], col[3], h});
     }
     Voxels vox;
     vox.vao = makeVertexArray();
@@ -200,13 +244,18 @@ void GpuScene::uploadVoxels(const Scene& scene) {
     glBindBuffer(GL_ARRAY_BUFFER, vox.instances.get());
     glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(inst.size() * sizeof(float)), inst.data(),
                  GL_STATIC_DRAW);
+    constexpr GLsizei stride = 8 * sizeof(float);
     glEnableVertexAttribArray(2);
-    glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, 7 * sizeof(float), nullptr);
+    glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, stride, nullptr);
     glVertexAttribDivisor(2, 1);
     glEnableVertexAttribArray(3);
-    glVertexAttribPointer(3, 4, GL_FLOAT, GL_FALSE, 7 * sizeof(float),
+    glVertexAttribPointer(3, 4, GL_FLOAT, GL_FALSE, stride,
                           reinterpret_cast<void*>(3 * sizeof(float)));
     glVertexAttribDivisor(3, 1);
+    glEnableVertexAttribArray(4);
+    glVertexAttribPointer(4, 1, GL_FLOAT, GL_FALSE, stride,
+                          reinterpret_cast<void*>(7 * sizeof(float)));
+    glVertexAttribDivisor(4, 1);
     voxels_.push_back(std::move(vox));
   }
 }

@@ -62,11 +62,18 @@ void Renderer::draw(const GpuScene& s, const RenderCamera& camera, Framebuffer& 
     glUseProgram(voxels_.get());
     setMvp(voxels_.get(), mvp);
     glUniform3f(glGetUniformLocation(voxels_.get(), "u_light_dir"), 0.3F, 0.5F, 0.8F);
+    // Cubes are closed and wound counter-clockwise seen from outside; every camera here maps that
+    // to counter-clockwise on screen (OpenCV frame, then y flipped to NDC), so back faces can go:
+    // half the triangles of a large voxel map never reach the rasteriser.
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CCW);
     for (const auto& v : s.voxels_) {
       glUniform1f(glGetUniformLocation(voxels_.get(), "u_size"), v.size_m);
       glBindVertexArray(v.vao.get());
       glDrawArraysInstanced(GL_TRIANGLES, 0, 36, v.count);
     }
+    glDisable(GL_CULL_FACE);
   }
   if (!s.point_ranges_.empty()) {
     glEnable(GL_PROGRAM_POINT_SIZE);

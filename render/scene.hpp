@@ -26,7 +26,9 @@ struct PointCloud {
   bool round = true;            // discs instead of squares
 };
 
-struct VoxelSet {  // axis-aligned cubes (OctoMap leaves), drawn instanced
+// Axis-aligned cubes (OctoMap leaves), drawn instanced. Faces two opaque voxels of one set share
+// on its lattice (spacing size_m, from the first centre) are never drawn: a voxel map is a solid.
+struct VoxelSet {
   std::vector<Eigen::Vector3d> centers;
   std::vector<Color> colors;  // default light grey
   double size_m = 0.2;

@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <chrono>
 #include <opencv2/imgproc.hpp>
 #include <regex>
 
@@ -34,6 +35,31 @@ std::pair<int, int> parseSize(const std::string& text) {
   return {w, h};
 }
 
+// Milliseconds since the previous lap, for the log line that breaks down where the time went.
+class Stopwatch {
+ public:
+  double lapMs() {
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
+    last_ = now;
+    return ms;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+void logSceneSize(const render::Scene& scene) {
+  for (const auto& pc : scene.point_clouds) {
+    if (pc.points.size() < 100) continue;  // markers
+    spdlog::debug("scene: {} points of {} px", pc.points.size(),
+                  pc.sizes_px.empty() ? 2.0F : pc.sizes_px.front());
+  }
+  for (const auto& v : scene.voxel_sets) {
+    spdlog::debug("scene: {} voxels of {:g} m", v.centers.size(), v.size_m);
+  }
+}
+
 cv::Mat toBgr(const render::ImageRgba& image) {
   cv::Mat rgba(image.height, image.width, CV_8UC4, const_cast<std::uint8_t*>(image.rgba.data())),
       bgr;
@@ -50,18 +76,29 @@ int runRender(const RenderCliOptions& o) {
   if (!std::filesystem::is_directory(out_dir)) {
     throw io::InputError(o.out, 0, "output folder does not exist");  // before rendering for nothing
   }
-  const io::RunFiles run = io::readRunDir(o.run, reference);
+  Stopwatch clock;
+  const io::RunFiles run = io::readRunDir(o.run, viz::readOptionsFor(view, reference));
+  const double read_ms = clock.lapMs();
   viz::ViewSpec spec = viz::buildRunView(run, view, width, height);
+  const double build_ms = clock.lapMs();
+  logSceneSize(spec.scene);
   const render::EglContext context;
   spdlog::info("EGL {}: {} ({})", context.info().platform, context.info().gl_renderer,
                context.info().gl_version);
   const render::Renderer renderer(context);
   render::Framebuffer target(width, height);
+  clock.lapMs();
   const render::GpuScene gpu(spec.scene);
+  spec.scene = {};  // uploaded: the CPU copy of a large map is no longer needed
+  const double upload_ms = clock.lapMs();
   render::ImageRgba image = renderer.renderColor(gpu, spec.camera, target);
+  const double draw_ms = clock.lapMs();
   render::annotate(image, spec.annotations);
   io::writePng(o.out, toBgr(image));
-  spdlog::info("wrote {} ({}x{}, view {})", o.out, width, height, o.view);
+  spdlog::info(
+      "wrote {} ({}x{}, view {}): read {:.0f} ms, scene {:.0f} ms, upload {:.0f} ms, "
+      "draw {:.0f} ms",
+      o.out, width, height, o.view, read_ms, build_ms, upload_ms, draw_ms);
   return 0;
 }
 
@@ -70,12 +107,14 @@ int runRender(const RenderCliOptions& o) {
 Command addRenderCommand(CLI::App& app) {
   auto o = std::make_shared<RenderCliOptions>();
   CLI::App* sub =
-      app.add_subcommand("render", "Draw a run's trajectories off-screen (EGL) into a PNG");
+      app.add_subcommand("render", "Draw a run's map and trajectories off-screen (EGL) into a PNG");
   sub->add_option("--run", o->run,
-                  "Run folder (trajectory.tum / trajectory_vio.tum, optional groundtruth.tum)")
+                  "Run folder (trajectory.tum / trajectory_vio.tum; optional groundtruth.tum, "
+                  "map.pcd, map.ot / map.bt, gnss_fixes.csv, report.json)")
       ->required();
   sub->add_option("--view", o->view,
-                  "topdown, perspective, or error (colour = APE against the truth)");
+                  "topdown (map), perspective (3-D cloud), octomap (voxels), or error (colour = "
+                  "APE against the truth)");
   sub->add_option("--size", o->size, "Image size WxH (1..16384 px per side)");
   sub->add_option("--reference", o->reference,
                   "Ground truth file (TUM/KITTI/EuRoC) instead of groundtruth.tum");

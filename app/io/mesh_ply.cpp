@@ -7,6 +7,7 @@
 
 #include "io/atomic_write.hpp"
 #include "io/input_error.hpp"
+#include "io/quiet_pcl.hpp"
 
 namespace gvio::io {
 
@@ -38,8 +39,14 @@ void writeMeshPly(const std::filesystem::path& file, const TriangleMesh& mesh) {
 TriangleMesh readMeshPly(const std::filesystem::path& file) {
   if (!std::filesystem::is_regular_file(file)) throw InputError(file, 0, "file not found");
   pcl::PolygonMesh pm;
-  if (pcl::io::loadPLYFile(file.string(), pm) != 0)
-    throw InputError(file, 0, "not a readable PLY mesh");
+  bool loaded = false;
+  try {
+    const QuietPcl quiet;
+    loaded = pcl::io::loadPLYFile(file.string(), pm) == 0;
+  } catch (const std::exception&) {  // some PCL paths throw pcl::IOException instead
+    loaded = false;
+  }
+  if (!loaded) throw InputError(file, 0, "not a readable PLY mesh");
   pcl::PointCloud<pcl::PointXYZ> cloud;
   pcl::fromPCLPointCloud2(pm.cloud, cloud);
   TriangleMesh mesh;

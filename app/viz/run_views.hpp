@@ -1,6 +1,14 @@
 #pragma once
 // The images `gvio render` draws of a run: which primitives, camera and 2-D annotations each
 // view uses. Pure scene building; the CLI owns the EGL context and the file output.
+//  - topdown:     orthographic ENU map, north up: the cloud coloured by height (when map.pcd
+//                 exists), trajectories, GNSS fixes (used / rejected / skipped) and outages on top.
+//  - perspective: the dense cloud from behind and above the start of the drive, with the
+//                 trajectory (without map.pcd: an orbit view of the trajectories, as before maps).
+//  - octomap:     the OctoMap's occupied voxels as shaded cubes, same viewpoint.
+//  - error:       the estimate coloured by its APE against the truth.
+#include <filesystem>
+#include <optional>
 #include <string>
 
 #include "io/run_dir.hpp"
@@ -10,8 +18,13 @@
 
 namespace gvio::viz {
 
-enum class RunView { kTopDown, kPerspective, kError };
-RunView parseRunView(const std::string& name);  // topdown|perspective|error; InvalidInput else
+enum class RunView { kTopDown, kPerspective, kOctomap, kError };
+// topdown|perspective|octomap|error; InvalidInput else.
+RunView parseRunView(const std::string& name);
+
+// The run files a view draws (the map files are large: read only what is drawn).
+io::RunReadOptions readOptionsFor(RunView view,
+                                  const std::optional<std::filesystem::path>& reference);
 
 struct ViewSpec {
   render::Scene scene;
@@ -19,7 +32,11 @@ struct ViewSpec {
   render::Annotations annotations;
 };
 
-// Throws InvalidInput when the view cannot be drawn from the run (error view without truth).
+// Throws InvalidInput when the view cannot be drawn from the run (error view without truth,
+// octomap view without map.ot / map.bt or without occupied voxels).
 ViewSpec buildRunView(const io::RunFiles& run, RunView view, int width, int height);
+
+// Metres one pixel spans at `p_w` (perspective: at its depth; orthographic: everywhere).
+double metresPerPixelAt(const render::RenderCamera& camera, const Eigen::Vector3d& p_w);
 
 }  // namespace gvio::viz

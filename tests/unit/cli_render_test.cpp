@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "io/trajectory_io.hpp"
+#include "render_map_fixture.hpp"
 #include "support/fixtures.hpp"
 
 namespace gvio::test {
@@ -63,7 +64,7 @@ TEST_F(CliRender, BadInputIsOneLineExit2) {
       {base + " --size 0x100", "1..16384"},
       {base + " --size 16385x100", "1..16384"},
       {base + " --size big", "expected WxH"},
-      {base + " --view sideways", "topdown, perspective or error"},
+      {base + " --view sideways", "topdown, perspective, octomap or error"},
       {"render --run " + run_.string() + " --out /nonexistent/dir/x.png", "/nonexistent/dir/x.png"},
   };
   for (const auto& [args, needle] : cases) {
@@ -83,6 +84,52 @@ TEST_F(CliRender, ErrorViewNeedsTruthAndEmptyTrajectoryIsRejected) {
   r = runGvio("render --run " + run_.string() + " --out " + out("e.png"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr("no poses"));
+}
+
+// The map views on a run folder with map.pcd, map.ot, gnss_fixes.csv and report.json.
+TEST_F(CliRender, MapViewsWriteImages) {
+  const fs::path map_run = dir_.path() / "map_run";
+  writeSyntheticMapRun(map_run);
+  for (const char* view : {"topdown", "perspective", "octomap"}) {
+    const std::string png = out(std::string("map_") + view + ".png");
+    const auto r = runGvio("render --run " + map_run.string() + " --view " + view +
+                           " --size 320x240 --out " + png);
+    ASSERT_EQ(r.exit_code, 0) << view << ": " << r.err;
+    const cv::Mat img = cv::imread(png);
+    ASSERT_FALSE(img.empty()) << view;
+    EXPECT_EQ(img.cols, 320);
+    EXPECT_EQ(img.rows, 240);
+    cv::Scalar mean, stddev;
+    cv::meanStdDev(img, mean, stddev);
+    EXPECT_GT(stddev[0], 5.0) << view << " looks blank";
+  }
+}
+
+TEST_F(CliRender, BadMapFilesAreOneLineExit2) {
+  const fs::path map_run = dir_.path() / "map_run";
+  writeSyntheticMapRun(map_run);
+  const std::string args = "render --run " + map_run.string() + " --out " + out("m.png");
+  auto expectOneLine = [&](const std::string& view, const std::string& needle) {
+    const auto r = runGvio(args + " --view " + view);
+    EXPECT_EQ(r.exit_code, 2) << view << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_THAT(r.err, HasSubstr(needle)) << view;
+  };
+  writeText(map_run / "gnss_fixes.csv", "t_s,e_m,n_m,u_m,status\n1,2,3,4,used\n1,2,x,4,used\n");
+  expectOneLine("topdown", "gnss_fixes.csv:3:");
+  fs::remove(map_run / "gnss_fixes.csv");
+  writeText(map_run / "map.pcd", "VERSION .7\nFIELDS x y z\n");
+  expectOneLine("perspective", "map.pcd: not a PCD file");
+  const std::string ot = readText(map_run / "map.ot");
+  writeText(map_run / "map.ot", ot.substr(0, ot.size() / 2));
+  expectOneLine("octomap", "map.ot: OctoMap data is truncated");
+  fs::remove(map_run / "map.ot");
+  expectOneLine("octomap", "the octomap view needs map.ot or map.bt");
+  // The error view reads none of these: it still works with them broken or missing.
+  writeText(map_run / "gnss_fixes.csv", "t_s,e_m,n_m,u_m,status\n1,2,x,4,used\n");
+  writeText(map_run / "report.json", "{");
+  io::writeTum(map_run / "groundtruth.tum", syntheticDrive());
+  EXPECT_EQ(runGvio(args + " --view error").exit_code, 0);
 }
 
 // With no EGL vendor library (glvnd finds none), every path fails and the CLI says so in one line.
