@@ -1,5 +1,6 @@
 #include "fusion/gnss_fusion.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -19,6 +20,20 @@ constexpr int kGraphIterations = 5;
 constexpr double kNoVelocityVariance = 1e8;
 
 }  // namespace
+
+std::string toString(FixStatus status) {
+  switch (status) {
+    case FixStatus::kUsed:
+      return "used";
+    case FixStatus::kRejected:
+      return "rejected";
+    case FixStatus::kUnmatched:
+      return "unmatched";
+    case FixStatus::kUnaligned:
+      return "unaligned";
+  }
+  return "";
+}
 
 std::string toString(FusionMode mode) {
   return mode == FusionMode::kKf ? "kf" : "graph";
@@ -47,12 +62,16 @@ void FusionConfig::validate() const {
     throw InvalidInput("config: fusion.max_consecutive_rejections must be >= 1");
   }
   positive(alignment_min_extent_m, "alignment_min_extent_m");
+  positive(alignment_min_cross_extent_m, "alignment_min_cross_extent_m");
   positive(vio_drift_fraction, "vio_drift_fraction");
   positive(vio_sigma_floor_m, "vio_sigma_floor_m");
   positive(vio_rot_drift_rad_per_m, "vio_rot_drift_rad_per_m");
   positive(vio_rot_floor_rad, "vio_rot_floor_rad");
   positive(huber_sigmas, "huber_sigmas");
   positive(gate_chi2, "gate_chi2");
+  if (!(std::isfinite(gate_floor_m) && gate_floor_m >= 0.0)) {
+    throw InvalidInput("config: fusion.gate_floor_m must be >= 0");
+  }
   positive(outage_s, "outage_s");
   kf.validate();
 }
@@ -70,10 +89,12 @@ struct GnssFusion::Impl {
 
   void processFix(const GnssFix& fix);
   void align(const Pair& pair);
+  [[nodiscard]] bool residualsConsistent(const Eigen::Isometry3d& T_enu_w) const;
   bool fuseGraph(const Pair& pair);
   bool fuseKf(const Pair& pair);
   Eigen::Isometry3d fusedPose(std::int64_t t_ns, const Eigen::Isometry3d& T_w_b) const;
   void noteAccepted(std::int64_t t_ns);
+  void noteOutcome(const Pair& pair, bool used);
 
   FusionConfig config;
   EnuFrame enu;
@@ -113,6 +134,31 @@ void GnssFusion::Impl::noteAccepted(std::int64_t t_ns) {
   consecutive_rejections = 0;
 }
 
+void GnssFusion::Impl::noteOutcome(const Pair& pair, bool used) {
+  stats.fixes.push_back({pair.t_ns, pair.p_enu, used ? FixStatus::kUsed : FixStatus::kRejected});
+  if (used) {
+    noteAccepted(pair.t_ns);
+  } else {
+    ++stats.fixes_rejected;
+  }
+}
+
+// The registration explains the fixes when the median squared residual, normalised by each fix's
+// sigma, stays within the gate (the median ignores the rare outlier). A chi-square(3) variable
+// has median 2.37; the gate (99.9 %) leaves room for the receiver's unmodelled bias.
+bool GnssFusion::Impl::residualsConsistent(const Eigen::Isometry3d& T) const {
+  std::vector<double> chi2;
+  for (const Pair& p : alignment_pairs) {
+    const Eigen::Vector3d r = p.p_enu - T * (p.T_w_b * config.lever_arm_b);
+    const double var_h = p.fix.sigma_h_m * p.fix.sigma_h_m;
+    chi2.push_back(r.head<2>().squaredNorm() / var_h +
+                   r.z() * r.z() / (p.fix.sigma_v_m * p.fix.sigma_v_m));
+  }
+  const auto mid = chi2.begin() + static_cast<std::ptrdiff_t>(chi2.size() / 2);
+  std::nth_element(chi2.begin(), mid, chi2.end());
+  return *mid <= config.gate_chi2;
+}
+
 void GnssFusion::Impl::align(const Pair& pair) {
   alignment_pairs.push_back(pair);
   if (static_cast<int>(alignment_pairs.size()) < config.alignment_min_fixes) return;
@@ -121,7 +167,12 @@ void GnssFusion::Impl::align(const Pair& pair) {
     p_w.push_back(p.T_w_b * config.lever_arm_b);
     p_enu.push_back(p.p_enu);
   }
-  T_enu_w = alignVioToEnu(p_w, p_enu, config.alignment, config.alignment_min_extent_m);
+  T_enu_w = alignVioToEnu(p_w, p_enu, config.alignment, config.alignment_min_extent_m,
+                          config.alignment_min_cross_extent_m);
+  if (T_enu_w && config.alignment == AlignmentDof::kRotationTranslation &&
+      !residualsConsistent(*T_enu_w)) {
+    T_enu_w.reset();  // e.g. a tilted start under the yaw-only stand-in: wait for more spread
+  }
   if (!T_enu_w) return;
   // Back-fill the poses seen so far with the registration, then start the chosen filter.
   stats.poses_before_alignment = static_cast<int>(vio.size());
@@ -129,12 +180,7 @@ void GnssFusion::Impl::align(const Pair& pair) {
   fused.poses.clear();
   for (const auto& T : vio.poses) fused.poses.push_back(*T_enu_w * T);
   for (const Pair& p : alignment_pairs) {
-    const bool used = config.mode == FusionMode::kGraph ? fuseGraph(p) : fuseKf(p);
-    if (used) {
-      noteAccepted(p.t_ns);
-    } else {
-      ++stats.fixes_rejected;
-    }
+    noteOutcome(p, config.mode == FusionMode::kGraph ? fuseGraph(p) : fuseKf(p));
   }
   alignment_pairs.clear();
 }
@@ -155,11 +201,12 @@ bool GnssFusion::Impl::fuseGraph(const Pair& pair) {
   // Gate: the fix against the antenna predicted by the VIO motion since the newest node. The node
   // is itself uncertain by up to about one fix's sigma (it rests on a few fixes seen through the
   // VIO), hence twice the fix variance plus the VIO drift since the node.
-  const double sigma_pred = config.vio_drift_fraction * dist + config.vio_sigma_floor_m;
+  const double sigma_motion = config.vio_drift_fraction * dist + config.vio_sigma_floor_m;
+  const double var_pred = sigma_motion * sigma_motion + config.gate_floor_m * config.gate_floor_m;
   const Eigen::Vector3d innovation = pair.p_enu - T_pred * lever;
-  const double var_h = 2.0 * pair.fix.sigma_h_m * pair.fix.sigma_h_m + sigma_pred * sigma_pred;
-  const Eigen::Vector3d variance(
-      var_h, var_h, 2.0 * pair.fix.sigma_v_m * pair.fix.sigma_v_m + sigma_pred * sigma_pred);
+  const double var_h = 2.0 * pair.fix.sigma_h_m * pair.fix.sigma_h_m + var_pred;
+  const Eigen::Vector3d variance(var_h, var_h,
+                                 2.0 * pair.fix.sigma_v_m * pair.fix.sigma_v_m + var_pred);
   const double chi2 = innovation.cwiseAbs2().cwiseQuotient(variance).sum();
   if (chi2 > config.gate_chi2 && consecutive_rejections < config.max_consecutive_rejections) {
     return false;
@@ -218,6 +265,8 @@ void GnssFusion::Impl::processFix(const GnssFix& fix) {
   const auto T_w_b = interpolatePose(vio, fix.t_ns);
   if (!T_w_b) {
     ++stats.fixes_unmatched;
+    stats.fixes.push_back({fix.t_ns, enu.toEnu({fix.lat_deg, fix.lon_deg, fix.h_ellipsoid_m}),
+                           FixStatus::kUnmatched});
     return;
   }
   Pair pair{fix.t_ns, *T_w_b, enu.toEnu({fix.lat_deg, fix.lon_deg, fix.h_ellipsoid_m}), fix};
@@ -225,12 +274,8 @@ void GnssFusion::Impl::processFix(const GnssFix& fix) {
     align(pair);
   } else {
     const bool used = config.mode == FusionMode::kGraph ? fuseGraph(pair) : fuseKf(pair);
-    if (used) {
-      noteAccepted(pair.t_ns);
-    } else {
-      ++stats.fixes_rejected;
-      ++consecutive_rejections;
-    }
+    noteOutcome(pair, used);
+    if (!used) ++consecutive_rejections;
   }
   stats.ms_per_fix.push_back(
       std::chrono::duration<double, std::milli>(Clock::now() - start).count());
@@ -271,6 +316,12 @@ void GnssFusion::finish() {
     s.processFix(s.pending.front());
     s.pending.pop_front();
   }
+  for (const Impl::Pair& p : s.alignment_pairs) {
+    s.stats.fixes.push_back({p.t_ns, p.p_enu, FixStatus::kUnaligned});
+  }
+  s.alignment_pairs.clear();
+  std::sort(s.stats.fixes.begin(), s.stats.fixes.end(),
+            [](const FixOutcome& a, const FixOutcome& b) { return a.t_ns < b.t_ns; });
   if (s.last_accepted_ns && !s.vio.empty() &&
       static_cast<double>(s.vio.t_ns.back() - *s.last_accepted_ns) * 1e-9 > s.config.outage_s) {
     s.stats.outages.emplace_back(*s.last_accepted_ns, s.vio.t_ns.back());

@@ -35,6 +35,9 @@ struct FusionConfig {
   AlignmentDof alignment = AlignmentDof::kYawTranslation;  // full rotation without an IMU
   int alignment_min_fixes = 5;
   double alignment_min_extent_m = 20.0;
+  // Full-rotation registration (no IMU) waits for this spread across the path (m, standard
+  // deviation); before it the yaw + translation registration stands in (vio_enu_alignment.hpp).
+  double alignment_min_cross_extent_m = 10.0;
   // VIO relative-motion noise between consecutive nodes: drift per metre travelled plus a floor.
   double vio_drift_fraction = 0.004;
   double vio_sigma_floor_m = 0.02;
@@ -42,11 +45,30 @@ struct FusionConfig {
   double vio_rot_floor_rad = 5e-4;
   int window_nodes = 20;
   double huber_sigmas = 2.0;
-  double gate_chi2 = 16.27;            // chi-square, 3 degrees of freedom, 99.9 %
+  double gate_chi2 = 16.27;  // chi-square, 3 degrees of freedom, 99.9 %
+  // Added (in quadrature, per axis) to the gate's predicted sigma: the VIO's motion between fixes
+  // is less accurate than vio_drift_fraction says just after initialisation, and the newest node
+  // is itself uncertain. Without it accurate (RTK-grade) fixes fail the gate and are dropped.
+  double gate_floor_m = 0.5;
   int max_consecutive_rejections = 5;  // then the next fix is accepted (re-convergence)
   double outage_s = 3.0;               // no accepted fix for longer than this is an outage
   KfConfig kf;
   void validate() const;  // throws InvalidInput naming the field
+};
+
+// What became of one screened fix.
+enum class FixStatus {
+  kUsed,       // fused
+  kRejected,   // failed the chi-square gate
+  kUnmatched,  // outside the VIO trajectory (no pose to compare with)
+  kUnaligned,  // the VIO never registered to ENU, so the fix was never fused
+};
+std::string toString(FixStatus status);  // used | rejected | unmatched | unaligned
+
+struct FixOutcome {
+  std::int64_t t_ns = 0;                            // after the receiver time offset
+  Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();  // the antenna position the fix reports
+  FixStatus status = FixStatus::kUsed;
 };
 
 struct FusionStats {
@@ -56,6 +78,7 @@ struct FusionStats {
   int poses_before_alignment = 0;  // fused with the first registration, back-filled
   std::vector<std::pair<std::int64_t, std::int64_t>> outages;  // [t0, t1] without accepted fixes
   std::vector<double> ms_per_fix;  // fusion cost of each processed fix (informational)
+  std::vector<FixOutcome> fixes;   // every screened fix in time order (maps, plots)
 };
 
 class GnssFusion {

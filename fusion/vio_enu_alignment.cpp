@@ -1,5 +1,6 @@
 #include "fusion/vio_enu_alignment.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -8,7 +9,8 @@ namespace gvio::fusion {
 
 std::optional<Eigen::Isometry3d> alignVioToEnu(const std::vector<Eigen::Vector3d>& p_w,
                                                const std::vector<Eigen::Vector3d>& p_enu,
-                                               AlignmentDof dof, double min_extent_m) {
+                                               AlignmentDof dof, double min_extent_m,
+                                               double min_cross_extent_m) {
   if (p_w.size() != p_enu.size() || p_w.size() < 3) return std::nullopt;
   const auto n = static_cast<double>(p_w.size());
   Eigen::Vector3d mean_w = Eigen::Vector3d::Zero(), mean_e = Eigen::Vector3d::Zero();
@@ -23,6 +25,9 @@ std::optional<Eigen::Isometry3d> alignVioToEnu(const std::vector<Eigen::Vector3d
   if (extent < min_extent_m) return std::nullopt;
 
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  if (dof == AlignmentDof::kRotationTranslation && crossExtent(p_w) < min_cross_extent_m) {
+    dof = AlignmentDof::kYawTranslation;
+  }
   if (dof == AlignmentDof::kYawTranslation) {
     // Minimising sum |Rz(yaw) a_k - b_k|^2 over centred points: yaw = atan2(sum a x b, sum a . b)
     // in the horizontal plane (the vertical components do not depend on yaw).
@@ -44,6 +49,19 @@ std::optional<Eigen::Isometry3d> alignVioToEnu(const std::vector<Eigen::Vector3d
   }
   T.translation() = mean_e - T.linear() * mean_w;
   return T;
+}
+
+double crossExtent(const std::vector<Eigen::Vector3d>& p) {
+  if (p.size() < 2) return 0.0;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& x : p) mean += x;
+  mean /= static_cast<double>(p.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& x : p) cov += (x - mean) * (x - mean).transpose();
+  cov /= static_cast<double>(p.size());
+  // Eigenvalues in increasing order: the middle one is the spread across the principal direction.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov, Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(eig.eigenvalues()(1), 0.0));
 }
 
 std::optional<Eigen::Isometry3d> interpolatePose(const Trajectory& traj, std::int64_t t_ns,

@@ -7,7 +7,6 @@
 
 #include "io/nmea.hpp"
 #include "odometry/error.hpp"
-#include "sim/rng.hpp"
 
 namespace gvio::sim {
 namespace {
@@ -19,49 +18,6 @@ constexpr std::int64_t kNsPerDay = 86'400 * kNsPerSecond;
 constexpr double kGeoidSeparationM = 47.0;
 // Period of the slow HDOP / satellite-count variation (constellation geometry changes in minutes).
 constexpr double kGeometryPeriodS = 900.0;
-
-// One receiver error model of the issue, all values 1-sigma in metres.
-struct ErrorModel {
-  double white_h_m = 0.0;  // white noise per horizontal axis (east, north)
-  double white_v_m = 0.0;  // white noise, up
-  double bias_m = 0.0;     // steady-state sigma of the Gauss-Markov bias per axis (0: no bias)
-  double bias_tau_s = 60.0;
-  double outlier_probability = 0.0;
-  double outlier_min_m = 5.0, outlier_max_m = 30.0;
-  // What the receiver reports: it knows its white noise, not the bias or the outliers.
-  double reported_sigma_h_m = 0.0, reported_sigma_v_m = 0.0;
-  int quality = 1;
-  double hdop_min = 0.0, hdop_max = 0.0;
-  int sats_min = 0, sats_max = 0;
-};
-
-ErrorModel modelFor(GnssNoise noise) {
-  ErrorModel m;
-  switch (noise) {
-    case GnssNoise::kNone:
-      // Exact positions, yet tiny positive sigmas: readers reject non-positive ones.
-      m.reported_sigma_h_m = 0.01;
-      m.reported_sigma_v_m = 0.02;
-      m.quality = 4;
-      m.hdop_min = 0.6, m.hdop_max = 0.9, m.sats_min = 14, m.sats_max = 20;
-      break;
-    case GnssNoise::kRtk:
-      m.white_h_m = m.reported_sigma_h_m = 0.02;
-      m.white_v_m = m.reported_sigma_v_m = 0.04;
-      m.quality = 4;  // RTK fixed
-      m.hdop_min = 0.6, m.hdop_max = 0.9, m.sats_min = 14, m.sats_max = 20;
-      break;
-    case GnssNoise::kSpp:
-      m.white_h_m = m.reported_sigma_h_m = 1.5;
-      m.white_v_m = m.reported_sigma_v_m = 3.0;
-      m.bias_m = 1.0;
-      m.outlier_probability = 0.01;
-      m.quality = 1;
-      m.hdop_min = 0.8, m.hdop_max = 2.0, m.sats_min = 7, m.sats_max = 12;
-      break;
-  }
-  return m;
-}
 
 std::int64_t periodNs(double rate_hz) {
   if (rate_hz != 1.0 && rate_hz != 5.0 && rate_hz != 10.0) {
@@ -77,23 +33,6 @@ bool inOutage(std::int64_t t_ns, const GnssSimOptions& options) {
   return false;
 }
 
-// Exact discretisation of a first-order Gauss-Markov process over dt: b' = phi b + sqrt(1 - phi^2)
-// sigma w with phi = exp(-dt/tau). It keeps the stationary variance sigma^2 for any dt, so gaps
-// from outages need no special case.
-Eigen::Vector3d propagateBias(const Eigen::Vector3d& bias, double dt_s, const ErrorModel& m,
-                              Rng& rng) {
-  const double phi = std::exp(-dt_s / m.bias_tau_s);
-  return phi * bias + std::sqrt(1.0 - phi * phi) * m.bias_m * rng.normal3();
-}
-
-// An outlier (multipath, wrong ambiguity): uniform magnitude in a random direction, the vertical
-// component halved before normalising because such errors are mostly horizontal.
-Eigen::Vector3d outlierError(const ErrorModel& m, Rng& rng) {
-  Eigen::Vector3d direction = rng.normal3();
-  direction.z() *= 0.5;
-  return rng.uniform(m.outlier_min_m, m.outlier_max_m) * direction.normalized();
-}
-
 struct Geometry {
   double hdop = 0.0;
   int num_sats = 0;
@@ -102,7 +41,7 @@ struct Geometry {
 // HDOP and the satellite count follow the constellation geometry: one slow sinusoid (random phase)
 // drives both, fewer satellites going with a higher HDOP. HDOP is rounded to the 0.1 that GGA
 // carries, so a written and re-read log reproduces it.
-Geometry geometryAt(const ErrorModel& m, double t_s, double phase) {
+Geometry geometryAt(const GnssErrorModel& m, double t_s, double phase) {
   const double poor = 0.5 + 0.5 * std::sin(2.0 * std::numbers::pi * t_s / kGeometryPeriodS + phase);
   Geometry g;
   g.hdop = std::round((m.hdop_min + poor * (m.hdop_max - m.hdop_min)) * 10.0) / 10.0;
@@ -110,33 +49,8 @@ Geometry geometryAt(const ErrorModel& m, double t_s, double phase) {
   return g;
 }
 
-// The state that carries from one fix to the next.
-struct ReceiverState {
-  Eigen::Vector3d bias = Eigen::Vector3d::Zero();
-  std::int64_t t_ns = 0;
-  double phase = 0.0;
-};
-
-// Error of one fix (ENU, metres); sets `outlier`. Draws nothing for an error-free model.
-Eigen::Vector3d drawError(std::int64_t t_ns, const ErrorModel& m, ReceiverState& state, Rng& rng,
-                          bool& outlier) {
-  Eigen::Vector3d error = Eigen::Vector3d::Zero();
-  if (m.bias_m > 0.0) {
-    const double dt_s = static_cast<double>(t_ns - state.t_ns) * 1e-9;
-    state.bias = propagateBias(state.bias, dt_s, m, rng);
-    error += state.bias;
-  }
-  state.t_ns = t_ns;
-  if (m.white_h_m > 0.0 || m.white_v_m > 0.0) {
-    error += rng.normal3().cwiseProduct(Eigen::Vector3d(m.white_h_m, m.white_h_m, m.white_v_m));
-  }
-  outlier = m.outlier_probability > 0.0 && rng.uniform() < m.outlier_probability;
-  if (outlier) error += outlierError(m, rng);
-  return error;
-}
-
 GnssFix reportedFix(std::int64_t t_ns, const Eigen::Vector3d& p_enu, const Geometry& geometry,
-                    const ErrorModel& m, const fusion::EnuFrame& enu) {
+                    const GnssErrorModel& m, const fusion::EnuFrame& enu) {
   const fusion::Lla lla = enu.toLla(p_enu);
   GnssFix fix;
   fix.t_ns = t_ns;
@@ -221,45 +135,22 @@ std::string gstBody(const GnssFix& fix, const std::string& time) {
 
 }  // namespace
 
-std::string toString(GnssNoise noise) {
-  switch (noise) {
-    case GnssNoise::kNone:
-      return "none";
-    case GnssNoise::kRtk:
-      return "rtk";
-    case GnssNoise::kSpp:
-      return "spp";
-  }
-  return "";
-}
-
-GnssNoise parseGnssNoise(const std::string& name) {
-  if (name == "none") return GnssNoise::kNone;
-  if (name == "rtk") return GnssNoise::kRtk;
-  if (name == "spp") return GnssNoise::kSpp;
-  throw InvalidInput("unknown GNSS noise model '" + name + "' (expected none, rtk or spp)");
-}
-
 std::vector<GnssSimFix> synthesizeGnss(
     const std::function<Eigen::Isometry3d(std::int64_t)>& T_w_b_at, std::int64_t t0_ns,
     std::int64_t t1_ns, const fusion::EnuFrame& enu, const GnssSimOptions& options,
     std::uint64_t seed) {
   const std::int64_t period_ns = periodNs(options.rate_hz);
-  const ErrorModel model = modelFor(options.noise);
-  Rng rng(seed);
-  ReceiverState state;
-  state.t_ns = t0_ns;
-  state.phase = rng.uniform(0.0, 2.0 * std::numbers::pi);
-  state.bias = model.bias_m * rng.normal3();  // drawn from the stationary distribution
+  const GnssErrorModel model = GnssErrorModel::preset(options.noise);
+  GnssErrorProcess errors(model, seed, t0_ns);
   std::vector<GnssSimFix> fixes;
   for (std::int64_t t_ns = t0_ns; t_ns <= t1_ns; t_ns += period_ns) {
     if (inOutage(t_ns, options)) continue;
     GnssSimFix sim;
     sim.p_enu_true = T_w_b_at(t_ns) * options.lever_arm_b;
-    sim.error_enu = drawError(t_ns, model, state, rng, sim.outlier);
+    sim.error_enu = errors.draw(t_ns, sim.outlier);
     const double t_s = static_cast<double>(t_ns - t0_ns) * 1e-9;
-    sim.fix = reportedFix(t_ns, sim.p_enu_true + sim.error_enu, geometryAt(model, t_s, state.phase),
-                          model, enu);
+    sim.fix = reportedFix(t_ns, sim.p_enu_true + sim.error_enu,
+                          geometryAt(model, t_s, errors.geometryPhase()), model, enu);
     fixes.push_back(sim);
   }
   return fixes;

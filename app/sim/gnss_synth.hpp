@@ -11,12 +11,9 @@
 
 #include "fusion/geodesy.hpp"
 #include "odometry/measurements.hpp"
+#include "sim/gnss_error.hpp"
 
 namespace gvio::sim {
-
-enum class GnssNoise { kNone, kRtk, kSpp };
-GnssNoise parseGnssNoise(const std::string& name);  // none|rtk|spp; throws InvalidInput
-std::string toString(GnssNoise noise);
 
 struct GnssSimOptions {
   GnssNoise noise = GnssNoise::kSpp;

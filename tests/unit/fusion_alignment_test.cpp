@@ -1,6 +1,7 @@
 // GNSS fix screening, VIO-world -> ENU registration and trajectory interpolation (fusion/).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -82,6 +83,34 @@ TEST(VioEnuAlignment, FullRotationWithoutAnImu) {
   const auto yaw_only = alignVioToEnu(p_w, p_enu, AlignmentDof::kYawTranslation);
   ASSERT_TRUE(yaw_only.has_value());
   EXPECT_GT((yaw_only->matrix() - T.matrix()).norm(), 0.1);
+}
+
+// A straight path with noisy fixes: the roll about the path is unobservable, and an unconstrained
+// full rotation tilts the world; below the cross-track spread the yaw solution stands in.
+TEST(VioEnuAlignment, StraightPathFallsBackToYawWithoutAnImu) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 1.5);
+  std::vector<Eigen::Vector3d> p_w, p_enu;
+  for (int k = 0; k < 6; ++k) {
+    p_w.emplace_back(8.0 * k, 0.0, 0.0);
+    p_enu.push_back(Eigen::Vector3d(0.0, 8.0 * k, 0.0) +
+                    Eigen::Vector3d(noise(rng), noise(rng), 2.0 * noise(rng)));
+  }
+  EXPECT_LT(crossExtent(p_w), 1e-9);
+  const auto unconstrained = alignVioToEnu(p_w, p_enu, AlignmentDof::kRotationTranslation);
+  const auto guarded = alignVioToEnu(p_w, p_enu, AlignmentDof::kRotationTranslation, 10.0, 10.0);
+  ASSERT_TRUE(unconstrained && guarded);
+  const auto tilt = [](const Eigen::Isometry3d& T) {
+    return std::acos(std::clamp(T.linear()(2, 2), -1.0, 1.0));
+  };
+  EXPECT_GT(tilt(*unconstrained), 0.05);  // a straight line leaves the roll to the noise
+  EXPECT_LT(tilt(*guarded), 1e-12);       // yaw only: the world's z stays up
+  // With a real spread across the path, the guard lets the full rotation through.
+  const auto wide = randomPath(rng, 20);
+  EXPECT_GT(crossExtent(wide), 10.0);
+  const auto full = alignVioToEnu(wide, wide, AlignmentDof::kRotationTranslation, 10.0, 10.0);
+  ASSERT_TRUE(full);
+  EXPECT_LT((full->matrix() - Eigen::Matrix4d::Identity()).norm(), 1e-9);
 }
 
 TEST(VioEnuAlignment, RefusesTooFewOrTooClosePoints) {

@@ -321,5 +321,54 @@ TEST(SimGnss, GnssCsvFormat) {
   EXPECT_EQ(rows, 2);
 }
 
+// --gnss-noise: degrading exact fixes adds exactly the process's error (same seed, same draws as
+// the simulator) and reports the model's sigmas.
+TEST(SimGnss, DegradeFixesAddsTheModelError) {
+  const std::vector<GnssFix> exact = reported(simulate(GnssNoise::kNone, 1.0, 2000.0));
+  const GnssErrorModel spp = GnssErrorModel::preset(GnssNoise::kSpp);
+  const DegradedFixes degraded = degradeFixes(exact, spp, 7);
+  ASSERT_EQ(degraded.fixes.size(), exact.size());
+  const fusion::EnuFrame enu({exact[0].lat_deg, exact[0].lon_deg, exact[0].h_ellipsoid_m});
+  GnssErrorProcess process(spp, 7, exact[0].t_ns);
+  double sum_sq_east = 0.0;
+  int inliers = 0;
+  for (std::size_t i = 0; i < exact.size(); ++i) {
+    const GnssFix& d = degraded.fixes[i];
+    const Eigen::Vector3d moved =
+        enu.toEnu({d.lat_deg, d.lon_deg, d.h_ellipsoid_m}) -
+        enu.toEnu({exact[i].lat_deg, exact[i].lon_deg, exact[i].h_ellipsoid_m});
+    bool outlier = false;
+    const Eigen::Vector3d expected = process.draw(exact[i].t_ns, outlier);
+    EXPECT_LT((moved - expected).norm(), 1e-6) << i;
+    EXPECT_LT((degraded.added_error_enu[i] - expected).norm(), 1e-12);
+    EXPECT_EQ(d.t_ns, exact[i].t_ns);
+    EXPECT_DOUBLE_EQ(d.sigma_h_m, 1.5);
+    EXPECT_DOUBLE_EQ(d.sigma_v_m, 3.0);
+    EXPECT_EQ(d.quality, 1);
+    if (!outlier) sum_sq_east += expected.x() * expected.x(), ++inliers;
+  }
+  // White 1.5 m + Gauss-Markov 1 m per horizontal axis: sqrt(1.5^2 + 1^2) = 1.80 m.
+  EXPECT_NEAR(std::sqrt(sum_sq_east / inliers), 1.80, 0.2);
+  EXPECT_GT(degraded.outliers, 5);
+  EXPECT_LT(degraded.outliers, 45);
+  EXPECT_TRUE(degradeFixes({}, spp, 7).fixes.empty());
+}
+
+TEST(SimGnss, NoiseModelValidation) {
+  GnssErrorModel m = GnssErrorModel::preset(GnssNoise::kSpp);
+  EXPECT_NO_THROW(m.validate());
+  m.bias_tau_s = 0.0;
+  EXPECT_THROW(m.validate(), InvalidInput);
+  m = GnssErrorModel::preset(GnssNoise::kSpp);
+  m.outlier_probability = 1.5;
+  EXPECT_THROW(m.validate(), InvalidInput);
+  m = GnssErrorModel::preset(GnssNoise::kSpp);
+  m.reported_sigma_h_m = 0.0;
+  EXPECT_THROW(m.validate(), InvalidInput);
+  m = GnssErrorModel::preset(GnssNoise::kSpp);
+  m.white_v_m = std::nan("");
+  EXPECT_THROW(m.validate(), InvalidInput);
+}
+
 }  // namespace
 }  // namespace gvio::sim
