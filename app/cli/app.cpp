@@ -98,6 +98,8 @@ int runMain(int argc, char** argv) {
   commands.push_back(addRenderCommand(app));
   commands.push_back(addSimulateCommand(app, common));
   commands.push_back(addRunCommand(app, common));
+  commands.push_back(addExportCommand(app));
+  commands.push_back(addConsistencyCommand(app));
 
   try {
     app.parse(argc, argv);

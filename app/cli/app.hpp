@@ -41,6 +41,8 @@ Command addEvalCommand(CLI::App& app);
 Command addRenderCommand(CLI::App& app);
 Command addSimulateCommand(CLI::App& app, const CommonOptions& common);
 Command addRunCommand(CLI::App& app, const CommonOptions& common);
+Command addExportCommand(CLI::App& app);
+Command addConsistencyCommand(CLI::App& app);
 
 int runMain(int argc, char** argv);
 

@@ -195,11 +195,13 @@ void AppConfig::validate() const {
   imu.noise.validate();
   vio.validate();
   fusion.validate();
+  map.map.validate();
   sim.validate();
 }
 
 std::vector<ConfigKey> configKeys(AppConfig& c) {
   odometry::EstimatorConfig& e = c.vio.estimator;
+  mapping::MapConfig& m = c.map.map;
   return {
       text("dataset.kitti_gnss_source", c.dataset.kitti_gnss_source),
       number("dataset.gap_factor", c.dataset.gap_factor),
@@ -249,6 +251,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("fusion.receiver_time_offset_s", c.fusion.fusion.receiver_time_offset_s),
       integer("fusion.alignment_min_fixes", c.fusion.fusion.alignment_min_fixes),
       number("fusion.alignment_min_extent_m", c.fusion.fusion.alignment_min_extent_m),
+      number("fusion.alignment_min_cross_extent_m", c.fusion.fusion.alignment_min_cross_extent_m),
       number("fusion.vio_drift_fraction", c.fusion.fusion.vio_drift_fraction),
       number("fusion.vio_sigma_floor_m", c.fusion.fusion.vio_sigma_floor_m),
       number("fusion.vio_rot_drift_rad_per_m", c.fusion.fusion.vio_rot_drift_rad_per_m),
@@ -256,6 +259,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       integer("fusion.window_nodes", c.fusion.fusion.window_nodes),
       number("fusion.huber_sigmas", c.fusion.fusion.huber_sigmas),
       number("fusion.gate_chi2", c.fusion.fusion.gate_chi2),
+      number("fusion.gate_floor_m", c.fusion.fusion.gate_floor_m),
       integer("fusion.max_consecutive_rejections", c.fusion.fusion.max_consecutive_rejections),
       number("fusion.outage_s", c.fusion.fusion.outage_s),
       number("fusion.kf.q_position", c.fusion.fusion.kf.q_position),
@@ -270,6 +274,25 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("sim.imu_rate_hz", c.sim.imu_rate_hz),
       number("sim.gnss_rate_hz", c.sim.gnss_rate_hz),
       vector3("sim.gnss_lever_arm_m", c.sim.gnss_lever_arm_m),
+      boolean("map.enabled", c.map.enabled),
+      integer("map.sparse.min_landmark_observations", m.sparse.min_landmark_observations),
+      number("map.sparse.max_landmark_reprojection_px", m.sparse.max_landmark_reprojection_px),
+      boolean("map.dense.enabled", m.dense.enabled),
+      integer("map.dense.every_n_keyframes", m.dense.every_n_keyframes),
+      number("map.dense.voxel_size_m", m.dense.voxel_size_m),
+      integer("map.dense.sor_mean_k", m.dense.sor_mean_k),
+      number("map.dense.sor_stddev_mul", m.dense.sor_stddev_mul),
+      number("map.dense.stereo.downscale", m.dense.stereo.downscale),
+      integer("map.dense.stereo.num_disparities", m.dense.stereo.num_disparities),
+      integer("map.dense.stereo.block_size", m.dense.stereo.block_size),
+      integer("map.dense.stereo.uniqueness_ratio", m.dense.stereo.uniqueness_ratio),
+      integer("map.dense.stereo.disp12_max_diff", m.dense.stereo.disp12_max_diff),
+      integer("map.dense.stereo.speckle_window_size", m.dense.stereo.speckle_window_size),
+      integer("map.dense.stereo.speckle_range", m.dense.stereo.speckle_range),
+      number("map.dense.stereo.min_range_m", m.dense.stereo.min_range_m),
+      number("map.dense.stereo.max_range_m", m.dense.stereo.max_range_m),
+      number("map.occupancy.resolution_m", m.occupancy.resolution_m),
+      number("map.occupancy.max_range_m", m.occupancy.max_range_m),
       number("sim.image_noise_dn", c.sim.image_noise_dn),
       boolean("sim.exposure_change", c.sim.exposure_change),
       number("sim.exposure_amplitude", c.sim.exposure_amplitude),
@@ -313,6 +336,35 @@ std::string dumpConfigYaml(const AppConfig& config) {
   if (!section.empty()) out << YAML::EndMap;
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
+}
+
+sim::GnssErrorModel loadGnssNoiseModel(const std::string& spec) {
+  if (spec == "spp" || spec == "rtk") return sim::GnssErrorModel::preset(sim::parseGnssNoise(spec));
+  const std::filesystem::path file(spec);
+  if (!std::filesystem::is_regular_file(file)) {
+    throw InvalidInput("--gnss-noise '" + spec +
+                       "': expected none, spp, rtk or a YAML noise-model file (not found)");
+  }
+  sim::GnssErrorModel m = sim::GnssErrorModel::preset(sim::GnssNoise::kSpp);
+  std::vector<ConfigKey> list{number("white_h_m", m.white_h_m),
+                              number("white_v_m", m.white_v_m),
+                              number("bias_m", m.bias_m),
+                              number("bias_tau_s", m.bias_tau_s),
+                              number("outlier_probability", m.outlier_probability),
+                              number("outlier_min_m", m.outlier_min_m),
+                              number("outlier_max_m", m.outlier_max_m),
+                              number("reported_sigma_h_m", m.reported_sigma_h_m),
+                              number("reported_sigma_v_m", m.reported_sigma_v_m),
+                              integer("quality", m.quality)};
+  std::map<std::string, ConfigKey*> keys;
+  for (ConfigKey& key : list) keys[key.name] = &key;
+  applyFile(file, keys, nullptr);
+  try {
+    m.validate();
+  } catch (const InvalidInput& e) {
+    throw io::InputError(file, 0, e.what());
+  }
+  return m;
 }
 
 }  // namespace gvio::cli

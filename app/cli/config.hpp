@@ -10,8 +10,10 @@
 
 #include "fusion/gnss_fusion.hpp"
 #include "io/reader_config.hpp"
+#include "mapping/map_config.hpp"
 #include "odometry/measurements.hpp"
 #include "odometry/vio_config.hpp"
+#include "sim/gnss_error.hpp"
 #include "sim/sim_config.hpp"
 
 namespace gvio::cli {
@@ -43,11 +45,18 @@ struct FusionAppConfig {
   void validate() const;  // throws InvalidInput naming the key
 };
 
+// gvio run's map (YAML section `map:`): sparse landmarks, dense stereo, OctoMap occupancy.
+struct MapAppConfig {
+  bool enabled = true;  // false: no map files (the run is trajectories only)
+  mapping::MapConfig map;
+};
+
 struct AppConfig {
   io::ReaderConfig dataset;
   ImuConfig imu;
   VioConfig vio;
   FusionAppConfig fusion;
+  MapAppConfig map;
   sim::SimConfig sim;
 
   void validate() const;  // throws InvalidInput naming the key
@@ -75,5 +84,11 @@ AppConfig loadConfig(const ConfigSources& sources,
 
 // The effective configuration as YAML, every key with its value (reproducible runs).
 std::string dumpConfigYaml(const AppConfig& config);
+
+// --gnss-noise: a preset (rtk | spp) or a YAML file of sim::GnssErrorModel's fields (white_h_m,
+// white_v_m, bias_m, bias_tau_s, outlier_probability, outlier_min_m, outlier_max_m,
+// reported_sigma_h_m, reported_sigma_v_m, quality) over the spp preset; unknown keys warn.
+// Throws InvalidInput/InputError (file and line) for a bad spec or value.
+sim::GnssErrorModel loadGnssNoiseModel(const std::string& spec);
 
 }  // namespace gvio::cli

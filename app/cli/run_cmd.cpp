@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "cli/app.hpp"
@@ -12,6 +13,7 @@
 #include "odometry/error.hpp"
 #include "run/evaluation.hpp"
 #include "run/gnss_run.hpp"
+#include "run/map_run.hpp"
 #include "run/report.hpp"
 #include "run/stats.hpp"
 #include "run/vio_runner.hpp"
@@ -24,6 +26,8 @@ struct RunOptions {
   std::string dataset;
   std::string format = "auto";
   std::string gnss = "auto";
+  std::string gnss_noise = "none";
+  std::uint64_t seed = 1;
   std::string out = "out/run";
   ConfigOptions config;
 };
@@ -44,12 +48,41 @@ void makeOutputDir(const fs::path& out) {
   }
 }
 
+// --gnss-noise: the dataset's (accurate) fixes degraded with a receiver error model, so a real
+// RTK-grade drive reproduces the reference experiment's SPP-grade GNSS. Returns report.json's
+// record of it (null for none).
+nlohmann::json degradeGnss(io::Dataset& ds, const std::string& spec, std::uint64_t seed) {
+  if (spec == "none") return nullptr;
+  const sim::GnssErrorModel model = loadGnssNoiseModel(spec);
+  if (ds.gnss.empty()) {
+    spdlog::warn("--gnss-noise {}: the dataset has no GNSS fixes to degrade", spec);
+    return nullptr;
+  }
+  const sim::DegradedFixes degraded = sim::degradeFixes(ds.gnss, model, seed);
+  ds.gnss = degraded.fixes;
+  double sum_sq = 0.0;
+  for (const Eigen::Vector3d& e : degraded.added_error_enu) sum_sq += e.squaredNorm();
+  const double rms_m = std::sqrt(sum_sq / static_cast<double>(degraded.fixes.size()));
+  spdlog::info(
+      "--gnss-noise {} (seed {}): {} fixes degraded, added error rms {:.2f} m, {} outliers", spec,
+      seed, degraded.fixes.size(), rms_m, degraded.outliers);
+  return {{"model", spec},
+          {"seed", seed},
+          {"white_h_m", model.white_h_m},
+          {"white_v_m", model.white_v_m},
+          {"bias_m", model.bias_m},
+          {"bias_tau_s", model.bias_tau_s},
+          {"outlier_probability", model.outlier_probability},
+          {"outliers", degraded.outliers},
+          {"added_error_rms_m", rms_m}};
+}
+
 int runRun(const RunOptions& opt, const CommonOptions& common) {
   checkGnssOption(opt.gnss);
   const AppConfig config = opt.config.load();
-  const io::Dataset ds =
-      io::readDataset(opt.dataset, io::parseDatasetFormat(opt.format), config.dataset);
+  io::Dataset ds = io::readDataset(opt.dataset, io::parseDatasetFormat(opt.format), config.dataset);
   for (const auto& w : ds.warnings) spdlog::warn("{}", w);
+  const nlohmann::json gnss_noise = degradeGnss(ds, opt.gnss_noise, opt.seed);
 
   odometry::EstimatorConfig estimator = config.vio.estimator;
   estimator.mode = run::chooseVioMode(config.vio.mode, ds);
@@ -69,11 +102,16 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
                ds.variant, ds.frames.size(), odometry::toString(estimator.mode));
 
   std::optional<Progress> progress;
-  const run::VioRunResult result =
-      run::runVio(ds, estimator, [&](std::size_t done, std::size_t total) {
+  std::optional<run::MapRecorder> recorder;
+  if (config.map.enabled) recorder.emplace(config.map.map);
+  const run::VioRunResult result = run::runVio(
+      ds, estimator,
+      [&](std::size_t done, std::size_t total) {
         if (!progress) progress.emplace("vio", total, "frames", common.progressStyle());
         progress->update(done);
-      });
+      },
+      recorder ? run::KeyframeFn([&](const run::KeyframeInput& kf) { recorder->addKeyframe(kf); })
+               : run::KeyframeFn());
   if (progress) progress->finish();
 
   if (result.trajectory.empty()) {
@@ -94,9 +132,21 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
                          config.fusion.originLla(), odometry::usesImu(estimator.mode));
     if (gnss) run::writeGeoreferencedOutputs(out, *gnss);
   }
+  nlohmann::json map_report;
+  if (recorder && !recorder->empty()) {
+    const run::MapRunResult map =
+        run::buildMap(*recorder, gnss && !gnss->fused.empty() ? &gnss->fused : nullptr);
+    run::writeMapFiles(out, map);
+    map_report = run::mapReport(*recorder, map);
+    spdlog::info("map ({}): {} landmarks, {} dense points, {} occupied voxels", map.frame,
+                 map.map.counts.sparse_points, map.map.counts.dense_points,
+                 map.map.counts.occupied_leaves);
+  }
   run::ReportContext context;
+  context.map = map_report;
   context.command_line = common.command_line;
   context.gnss_requested = opt.gnss;
+  context.gnss_noise = gnss_noise;
   if (odometry::usesImu(estimator.mode))
     context.imu_noise_source = dataset_noise ? "dataset" : "config";
   context.peak_rss_mb = run::peakRssMb();
@@ -151,6 +201,11 @@ Command addRunCommand(CLI::App& app, const CommonOptions& common) {
                   "GNSS fusion: auto (graph when the dataset has fixes), off, kf (the reference "
                   "Kalman filter) or graph")
       ->capture_default_str();
+  sub->add_option("--gnss-noise", opt->gnss_noise,
+                  "Degrade the dataset's GNSS fixes: none, spp, rtk or a YAML noise-model file "
+                  "(reproduces SPP-grade GNSS on an RTK-grade recording)")
+      ->capture_default_str();
+  sub->add_option("--seed", opt->seed, "Random seed of --gnss-noise")->capture_default_str();
   sub->add_option("--out", opt->out, "Run folder (created if missing; files in it are replaced)")
       ->capture_default_str();
   opt->config.addTo(*sub);

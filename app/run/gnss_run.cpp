@@ -57,7 +57,18 @@ std::optional<GnssRunResult> fuseGnss(const io::Dataset& ds, const Trajectory& v
   return r;
 }
 
+void writeGnssFixes(const std::filesystem::path& file, const GnssRunResult& r) {
+  io::writeFileAtomic(file, [&](std::ostream& os) {
+    os << "t_s,e_m,n_m,u_m,status\n";
+    for (const fusion::FixOutcome& f : r.stats.fixes) {
+      os << fmt::format("{:.9f},{:.4f},{:.4f},{:.4f},{}\n", seconds(f.t_ns), f.p_enu.x(),
+                        f.p_enu.y(), f.p_enu.z(), fusion::toString(f.status));
+    }
+  });
+}
+
 void writeGeoreferencedOutputs(const std::filesystem::path& out, const GnssRunResult& r) {
+  writeGnssFixes(out / "gnss_fixes.csv", r);
   if (r.fused.empty()) return;
   io::writeTum(out / "trajectory.tum", r.fused);
   const fusion::EnuFrame enu(r.origin);

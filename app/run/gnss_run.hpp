@@ -30,8 +30,12 @@ std::optional<GnssRunResult> fuseGnss(const io::Dataset& dataset, const Trajecto
                                       fusion::FusionMode mode, fusion::FusionConfig config,
                                       const std::optional<fusion::Lla>& origin, bool has_imu);
 
-// trajectory.tum (T_enu_b), trajectory_lla.csv (t, lat, lon, h, qw qx qy qz of the body in ENU) and
-// georef.json, all atomically.
+// gnss_fixes.csv: every screened fix in local ENU with what became of it
+// ("t_s,e_m,n_m,u_m,status", status used | rejected | unmatched | unaligned).
+void writeGnssFixes(const std::filesystem::path& file, const GnssRunResult& result);
+
+// gnss_fixes.csv, and when the fusion registered: trajectory.tum (T_enu_b), trajectory_lla.csv (t,
+// lat, lon, h, qw qx qy qz of the body in ENU) and georef.json, all atomically.
 void writeGeoreferencedOutputs(const std::filesystem::path& out, const GnssRunResult& result);
 
 // report.json's "gnss" object and "outages" array.

@@ -67,9 +67,11 @@ json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportCon
                          {"total", timingJson(run.timings.total_ms)}};
   report["wall_s"] = run.wall_s;
   report["peak_rss_mb"] = ctx.peak_rss_mb;
+  if (!ctx.map.is_null()) report["map"] = ctx.map;
   if (ctx.gnss) {
     report["gnss"] = gnssReport(*ctx.gnss, ds.gnss.size());
     report["gnss"]["requested"] = ctx.gnss_requested;
+    if (!ctx.gnss_noise.is_null()) report["gnss"]["noise_added"] = ctx.gnss_noise;
     report["outages"] = outagesReport(*ctx.gnss);
   } else {
     report["gnss"] = {{"requested", ctx.gnss_requested},

@@ -15,6 +15,8 @@ namespace gvio::run {
 struct ReportContext {
   std::string command_line;
   std::string gnss_requested = "off";  // the --gnss value as given
+  nlohmann::json gnss_noise;           // --gnss-noise applied to the fixes, null when none
+  nlohmann::json map;                  // run/map_run.hpp mapReport, null without a map
   std::string imu_noise_source;        // "dataset" or "config"; empty when the mode has no IMU
   double peak_rss_mb = 0.0;
   const EvaluationOutcome* evaluation = nullptr;       // null: the dataset has no ground truth

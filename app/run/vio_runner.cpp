@@ -108,7 +108,7 @@ VioMode chooseVioMode(const std::string& mode, const io::Dataset& ds) {
 }
 
 VioRunResult runVio(const io::Dataset& ds, odometry::EstimatorConfig config,
-                    const ProgressFn& progress) {
+                    const ProgressFn& progress, const KeyframeFn& on_keyframe) {
   const auto start = Clock::now();
   VioRunResult r;
   r.mode = config.mode;
@@ -167,6 +167,10 @@ VioRunResult runVio(const io::Dataset& ds, odometry::EstimatorConfig config,
     if (!r.trajectory.t_ns.empty() && frame.t_ns <= r.trajectory.t_ns.back()) continue;
     r.trajectory.t_ns.push_back(frame.t_ns);
     r.trajectory.poses.push_back(result.T_w_b);
+    if (result.keyframe && on_keyframe) {
+      on_keyframe({frame.t_ns, result.T_w_b, images.left, images.right, rectifier.left(),
+                   rectifier.baselineM(), estimator});
+    }
   }
   if (progress) progress(frames_done, ds.frames.size());
   appendEvents(estimator, r.events);

@@ -47,10 +47,24 @@ struct VioRunResult {
 
 using ProgressFn = std::function<void(std::size_t frames_done, std::size_t frames_total)>;
 
+// What the map needs of a keyframe, handed over as the estimator declares it (initialised, finite
+// pose). The images are the rectified pair (right empty in mono); the references live only for
+// the call.
+struct KeyframeInput {
+  std::int64_t t_ns = 0;
+  const Eigen::Isometry3d& T_w_b;
+  const cv::Mat& left;
+  const cv::Mat& right;
+  const CameraModel& left_camera;  // rectified
+  double baseline_m = 0.0;         // 0 in mono
+  const odometry::VioEstimator& estimator;
+};
+using KeyframeFn = std::function<void(const KeyframeInput&)>;
+
 // `config.mode` and `config.imu_noise` are the run's (chooseVioMode, dataset or imu.* noise); the
 // tracker's stereo flag is set here from the mode. Throws InvalidInput for cameras the rectifier
 // or estimator refuse; unreadable images only skip their frame (logged once per folder).
 VioRunResult runVio(const io::Dataset& dataset, odometry::EstimatorConfig config,
-                    const ProgressFn& progress = {});
+                    const ProgressFn& progress = {}, const KeyframeFn& on_keyframe = {});
 
 }  // namespace gvio::run

@@ -104,5 +104,64 @@ TEST_F(CliRunGnss, WithoutFixesTheRunIsPureVio) {
   EXPECT_EQ(report(out)["gnss"]["mode"], "off");
 }
 
+// --gnss-noise spp degrades an exact ("rtk"-free, noise none) simulated source: the fused error
+// grows from centimetres to metres, report.json records the model and seed, and the same seed
+// reproduces the same run. gnss_fixes.csv lists every fix with its outcome.
+TEST_F(CliRunGnss, GnssNoiseDegradesAnAccurateSource) {
+  const fs::path dataset = drive("--gnss-noise none");
+  const fs::path exact = tmp_.path() / "exact";
+  ASSERT_EQ(run(dataset, "graph", exact).exit_code, 0);
+  const fs::path spp = tmp_.path() / "spp";
+  const std::string noise = " --gnss-noise spp --seed 3";
+  const CommandResult r = run(dataset, "graph" + noise, spp);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto rep_exact = report(exact), rep_spp = report(spp);
+  EXPECT_FALSE(rep_exact["gnss"].contains("noise_added"));
+  EXPECT_EQ(rep_spp["gnss"]["noise_added"]["model"], "spp");
+  EXPECT_EQ(rep_spp["gnss"]["noise_added"]["seed"], 3);
+  EXPECT_GT(rep_spp["gnss"]["noise_added"]["added_error_rms_m"].get<double>(), 1.0);
+  const double ape_exact = rep_exact["evaluation_fused"]["ape_none"]["rmse"].get<double>();
+  const double ape_spp = rep_spp["evaluation_fused"]["ape_none"]["rmse"].get<double>();
+  EXPECT_LT(ape_exact, 0.3);
+  EXPECT_GT(ape_spp, 2.0 * ape_exact);
+  const fs::path again = tmp_.path() / "again";
+  ASSERT_EQ(run(dataset, "graph" + noise, again).exit_code, 0);
+  EXPECT_EQ(readText(again / "trajectory.tum"), readText(spp / "trajectory.tum"));
+
+  std::istringstream fixes(readText(spp / "gnss_fixes.csv"));
+  std::string line;
+  std::getline(fixes, line);
+  EXPECT_EQ(line, "t_s,e_m,n_m,u_m,status");
+  int rows = 0, used = 0;
+  while (std::getline(fixes, line)) {
+    ++rows;
+    used += line.ends_with(",used") ? 1 : 0;
+  }
+  EXPECT_EQ(rows, rep_spp["gnss"]["fixes"].get<int>() - rep_spp["gnss"]["skipped"].get<int>());
+  EXPECT_EQ(used, rep_spp["gnss"]["used"].get<int>());
+}
+
+TEST_F(CliRunGnss, GnssNoiseFromAFileAndBadSpecs) {
+  const fs::path dataset = drive("--gnss-noise none");
+  const fs::path model = tmp_.path() / "noise.yaml";
+  writeText(model,
+            "white_h_m: 0.5\nwhite_v_m: 1.0\nbias_m: 0.0\noutlier_probability: 0\n"
+            "reported_sigma_h_m: 0.5\nreported_sigma_v_m: 1.0\n");
+  const fs::path out = tmp_.path() / "file";
+  const CommandResult r = run(dataset, "graph --gnss-noise " + quotedPath(model), out);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(report(out)["gnss"]["noise_added"]["outliers"], 0);
+  EXPECT_NEAR(report(out)["gnss"]["noise_added"]["white_h_m"].get<double>(), 0.5, 1e-12);
+
+  const CommandResult missing = run(dataset, "graph --gnss-noise nosuch.yaml", tmp_.path() / "m");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("nosuch.yaml"), std::string::npos) << missing.err;
+  writeText(model, "bias_tau_s: -1\n");
+  const CommandResult bad =
+      run(dataset, "graph --gnss-noise " + quotedPath(model), tmp_.path() / "b");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("bias_tau_s"), std::string::npos) << bad.err;
+}
+
 }  // namespace
 }  // namespace gvio::test

@@ -1,0 +1,120 @@
+// gvio consistency: a run's map against a reference surface (a triangle mesh in the map's frame,
+// e.g. a simulated drive's world/world.ply, or a survey mesh in the run's local ENU): distance of
+// the dense points and of the sparse landmarks to the surface, and the share of occupied OctoMap
+// voxels near it (mapping/consistency.hpp). The issue's targets are reported beside each figure.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <octomap/OcTree.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli/app.hpp"
+#include "io/atomic_write.hpp"
+#include "io/input_error.hpp"
+#include "io/mesh_ply.hpp"
+#include "io/run_dir.hpp"
+#include "mapping/consistency.hpp"
+
+namespace gvio::cli {
+namespace {
+namespace fs = std::filesystem;
+
+// Issue 8's bounds (median distance to the true surface; occupied voxels within 2 voxels).
+constexpr double kDenseMedianM = 0.15;
+constexpr double kSparseMedianM = 0.3;
+constexpr double kOccupiedNearFraction = 0.9;
+constexpr double kOccupancyWithinVoxels = 2.0;
+
+struct ConsistencyOptions {
+  std::string run, reference;
+  std::optional<std::string> json;
+  double max_distance_m = 2.0;
+};
+
+nlohmann::json distanceJson(const mapping::SurfaceDistanceStats& s, double target_median_m) {
+  return {{"n", s.n},
+          {"median_m", s.median_m},
+          {"mean_m", s.mean_m},
+          {"p90_m", s.p90_m},
+          {"rmse_m", s.rmse_m},
+          {"within_m", s.within_m},
+          {"fraction_within", s.fraction_within},
+          {"beyond_max_distance", s.far},
+          {"max_distance_m", s.max_distance_m},
+          {"target_median_m", target_median_m},
+          {"meets_target", s.n > 0 && s.median_m <= target_median_m}};
+}
+
+// map.bt (the maximum-likelihood OcTree); nullopt when the run wrote none.
+std::unique_ptr<octomap::OcTree> readOcTree(const fs::path& file) {
+  if (!fs::exists(file)) return nullptr;
+  auto tree = std::make_unique<octomap::OcTree>(0.1);
+  if (!tree->readBinary(file.string()) || tree->size() == 0) {
+    throw io::InputError(file, 0, "not a readable OctoMap binary tree (.bt)");
+  }
+  return tree;
+}
+
+int runConsistency(const ConsistencyOptions& o) {
+  if (!(o.max_distance_m > 0.0)) throw InvalidInput("--max-distance must be > 0");
+  const fs::path run(o.run);
+  if (!fs::is_directory(run)) throw io::InputError(run, 0, "run folder not found");
+  const fs::path pcd = run / "map.pcd";
+  if (!fs::exists(pcd)) {
+    throw io::InputError(pcd, 0, "no map in the run folder (gvio run writes it with map.enabled)");
+  }
+  const io::MapCloud cloud = io::readMapCloud(pcd);
+  const io::TriangleMesh mesh = io::readMeshPly(o.reference);
+  const mapping::TriangleMeshIndex surface(mesh.vertices, mesh.triangles);
+  std::vector<Eigen::Vector3d> dense, sparse;
+  for (std::size_t i = 0; i < cloud.p_enu.size(); ++i) {
+    const bool is_sparse = !cloud.source.empty() && cloud.source[i] == io::MapCloud::kSparse;
+    (is_sparse ? sparse : dense).push_back(cloud.p_enu[i].cast<double>());
+  }
+  nlohmann::json j;
+  j["run"] = run.string();
+  j["reference"] = {{"file", o.reference}, {"triangles", surface.triangleCount()}};
+  const auto d = mapping::cloudToSurface(surface, dense, o.max_distance_m, kDenseMedianM);
+  const auto s = mapping::cloudToSurface(surface, sparse, o.max_distance_m, kSparseMedianM);
+  j["dense"] = distanceJson(d, kDenseMedianM);
+  j["sparse"] = distanceJson(s, kSparseMedianM);
+  spdlog::info("dense points: {} , median {:.3f} m, p90 {:.3f} m to the reference (target <= {} m)",
+               d.n, d.median_m, d.p90_m, kDenseMedianM);
+  spdlog::info("sparse landmarks: {}, median {:.3f} m, p90 {:.3f} m (target <= {} m)", s.n,
+               s.median_m, s.p90_m, kSparseMedianM);
+  if (const auto tree = readOcTree(run / "map.bt")) {
+    const auto occ = mapping::occupancyNearSurface(surface, *tree, kOccupancyWithinVoxels);
+    j["occupancy"] = {{"resolution_m", tree->getResolution()},
+                      {"occupied_voxels", occ.occupied_voxels},
+                      {"near_surface", occ.near_surface},
+                      {"within_m", occ.within_m},
+                      {"fraction_near", occ.fraction_near},
+                      {"target_fraction", kOccupiedNearFraction},
+                      {"meets_target", occ.fraction_near >= kOccupiedNearFraction}};
+    spdlog::info("occupied voxels: {}, {:.1f} % within {:.2f} m of the reference (target >= {} %)",
+                 occ.occupied_voxels, 100.0 * occ.fraction_near, occ.within_m,
+                 100.0 * kOccupiedNearFraction);
+  }
+  if (o.json) io::writeTextAtomic(*o.json, j.dump(2) + "\n");
+  return 0;
+}
+
+}  // namespace
+
+Command addConsistencyCommand(CLI::App& app) {
+  auto o = std::make_shared<ConsistencyOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "consistency", "Compare a run's map (map.pcd, map.bt) with a reference mesh in its frame");
+  sub->add_option("--run", o->run, "Run folder (the --out of gvio run)")->required();
+  sub->add_option("--reference", o->reference,
+                  "Reference triangle mesh (PLY) in the run's map frame (local ENU)")
+      ->required();
+  sub->add_option("--json", o->json, "Write the metrics as JSON");
+  sub->add_option("--max-distance", o->max_distance_m,
+                  "Search radius (m): points farther from the surface count as this distance")
+      ->capture_default_str();
+  return {sub, [o] { return runConsistency(*o); }};
+}
+
+}  // namespace gvio::cli

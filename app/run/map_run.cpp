@@ -1,0 +1,105 @@
+#include "run/map_run.hpp"
+
+#include <pcl/conversions.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+
+#include "export/map_files.hpp"
+#include "fusion/vio_enu_alignment.hpp"
+#include "io/atomic_write.hpp"
+#include "io/input_error.hpp"
+#include "run/stats.hpp"
+
+namespace gvio::run {
+namespace {
+
+nlohmann::json timingJson(const std::vector<double>& ms) {
+  const TimingSummary t = summarizeTimings(ms);
+  return {{"mean", t.mean}, {"p95", t.p95}, {"max", t.max}, {"n", ms.size()}};
+}
+
+// OctoMap writes by file name: a temporary sibling with the same extension, then the rename.
+// `binary`: the maximum-likelihood .bt of an OcTree; else the full .ot of any tree.
+void writeTreeAtomic(const std::filesystem::path& file,
+                     const octomap::AbstractOccupancyOcTree& tree, bool binary) {
+  const std::filesystem::path tmp = io::temporarySibling(file, file.extension().string());
+  const bool ok = binary ? tree.writeBinaryConst(tmp.string()) : tree.write(tmp.string());
+  if (!ok) {
+    std::filesystem::remove(tmp);
+    throw io::InputError(file, 0, "cannot write the OctoMap file");
+  }
+  io::moveIntoPlace(tmp, file);
+}
+
+}  // namespace
+
+MapRecorder::MapRecorder(const mapping::MapConfig& config) : config_(config) {
+  config_.validate();
+}
+
+void MapRecorder::addKeyframe(const KeyframeInput& kf) {
+  if (!builder_) {
+    builder_ = std::make_unique<mapping::MapBuilder>(config_, kf.left_camera, kf.baseline_m);
+  }
+  timings_.push_back(
+      builder_->addKeyframe(kf.t_ns, kf.T_w_b, kf.left, kf.right, kf.estimator.landmarks()));
+}
+
+MapRunResult buildMap(const MapRecorder& recorder, const Trajectory* fused) {
+  const auto start = std::chrono::steady_clock::now();
+  MapRunResult r;
+  const bool enu = fused != nullptr && !fused->empty();
+  r.frame = enu ? "enu" : "vio_world";
+  const mapping::PoseLookup pose_of = enu ? mapping::PoseLookup([fused](std::int64_t t_ns) {
+    return fusion::interpolatePose(*fused, t_ns);
+  })
+                                          : recorder.builder().vioPoses();
+  r.map = recorder.builder().build(pose_of);
+  r.build_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+void writeMapFiles(const std::filesystem::path& out, const MapRunResult& r) {
+  const mapping::MapCloud cloud = mapping::mergeMapClouds(r.map.sparse, r.map.dense);
+  if (cloud.empty()) {
+    spdlog::warn("the map is empty (no keyframe had landmarks or depth): no map files written");
+    return;
+  }
+  pcl::PCLPointCloud2 blob;
+  pcl::toPCLPointCloud2(cloud, blob);
+  exporter::writePcd(out / "map.pcd", blob);
+  exporter::writePly(out / "map.ply", blob);
+  if (r.map.occupancy) writeTreeAtomic(out / "map.bt", *r.map.occupancy, true);
+  if (r.map.occupancy_color) writeTreeAtomic(out / "map.ot", *r.map.occupancy_color, false);
+}
+
+nlohmann::json mapReport(const MapRecorder& recorder, const MapRunResult& r) {
+  const mapping::MapCounts& c = r.map.counts;
+  std::vector<double> sparse_ms, dense_ms;
+  for (const auto& t : recorder.timings()) {
+    sparse_ms.push_back(t.ms_sparse);
+    if (t.ms_dense > 0.0) dense_ms.push_back(t.ms_dense);
+  }
+  return {{"frame", r.frame},
+          {"keyframes", c.keyframes},
+          {"keyframes_used", c.keyframes_used},
+          {"keyframes_without_pose", c.keyframes_skipped},
+          {"sparse_points", c.sparse_points},
+          {"landmarks_stored", c.landmarks_stored},
+          {"landmarks_rejected", c.landmarks_rejected},
+          {"dense_points", c.dense_points},
+          {"dense_points_before_filters", c.dense_points_raw},
+          {"occupied_voxels", c.occupied_leaves},
+          {"ms_per_keyframe",
+           {{"sparse", timingJson(sparse_ms)},
+            {"dense_depth", timingJson(dense_ms)},
+            {"octomap", timingJson(r.map.ms_octomap_per_keyframe)}}},
+          {"ms_dense_filters", r.map.ms_dense_fusion},
+          {"ms_build", r.build_ms},
+          {"store_mb", static_cast<double>(c.store_bytes) / 1e6},
+          {"octree_mb", static_cast<double>(c.octree_bytes) / 1e6}};
+}
+
+}  // namespace gvio::run

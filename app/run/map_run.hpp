@@ -1,0 +1,55 @@
+#pragma once
+// gvio run's map stage: keyframes go into a mapping::MapBuilder while the VIO runs (their dense
+// stereo points and landmarks in their own frames); after GNSS fusion the map is built from the
+// final poses (T_enu_b when fused, else the VIO poses) and written as map.pcd, map.ply (the merged
+// sparse + dense cloud, float32) and map.bt / map.ot (OctoMap OcTree / ColorOcTree).
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "mapping/map_builder.hpp"
+#include "odometry/trajectory.hpp"
+#include "run/vio_runner.hpp"
+
+namespace gvio::run {
+
+class MapRecorder {
+ public:
+  explicit MapRecorder(const mapping::MapConfig& config);
+
+  // The runVio keyframe hook: the builder is made at the first keyframe (the rectified camera is
+  // known only then).
+  void addKeyframe(const KeyframeInput& keyframe);
+
+  [[nodiscard]] bool empty() const { return !builder_; }
+  [[nodiscard]] const mapping::MapBuilder& builder() const { return *builder_; }
+  [[nodiscard]] const std::vector<mapping::KeyframeTimings>& timings() const { return timings_; }
+
+ private:
+  mapping::MapConfig config_;
+  std::unique_ptr<mapping::MapBuilder> builder_;
+  std::vector<mapping::KeyframeTimings> timings_;
+};
+
+struct MapRunResult {
+  mapping::MapBuildResult map;
+  std::string frame;  // "enu" (GNSS-fused poses) or "vio_world"
+  double build_ms = 0.0;
+};
+
+// Builds the map with the fused trajectory's poses (interpolated at the keyframe stamps) when
+// `fused` is given and not empty, else with the keyframes' VIO poses.
+MapRunResult buildMap(const MapRecorder& recorder, const Trajectory* fused);
+
+// map.pcd (binary compressed), map.ply (binary), map.bt, map.ot, each atomically. An empty map
+// writes nothing and warns.
+void writeMapFiles(const std::filesystem::path& out, const MapRunResult& result);
+
+// report.json's "map": frame, counts, per-keyframe cost of each stage (ms mean/p95/max), memory.
+nlohmann::json mapReport(const MapRecorder& recorder, const MapRunResult& result);
+
+}  // namespace gvio::run
