@@ -12,6 +12,7 @@
 #include "odometry/error.hpp"
 #include "render/renderer.hpp"
 #include "render_map_fixture.hpp"
+#include "support/render_fixture.hpp"
 #include "viz/map_layers.hpp"
 #include "viz/run_views.hpp"
 
@@ -22,17 +23,15 @@ using viz::RunView;
 
 constexpr int kW = 320, kH = 240;
 
-class RenderMapViews : public ::testing::Test {
+class RenderMapViews : public SharedRendererTest {
  protected:
   static void SetUpTestSuite() {
     dir_ = std::make_unique<TempDir>("rendermap");
     writeSyntheticMapRun(dir_->path() / "run");
-    context_ = std::make_unique<render::EglContext>();
-    renderer_ = std::make_unique<render::Renderer>(*context_);
+    SharedRendererTest::SetUpTestSuite();
   }
   static void TearDownTestSuite() {
-    renderer_.reset();
-    context_.reset();
+    SharedRendererTest::TearDownTestSuite();
     dir_.reset();
   }
   static io::RunFiles run() { return io::readRunDir(dir_->path() / "run"); }
@@ -49,12 +48,8 @@ class RenderMapViews : public ::testing::Test {
     return img;
   }
   static std::unique_ptr<TempDir> dir_;
-  static std::unique_ptr<render::EglContext> context_;
-  static std::unique_ptr<render::Renderer> renderer_;
 };
 std::unique_ptr<TempDir> RenderMapViews::dir_;
-std::unique_ptr<render::EglContext> RenderMapViews::context_;
-std::unique_ptr<render::Renderer> RenderMapViews::renderer_;
 
 // Colour (0..1) of the pixel where `camera` projects `p`; fails the test when it is off-image.
 Eigen::Vector3d colourAt(const render::ImageRgba& img, const render::RenderCamera& camera,

@@ -5,30 +5,19 @@
 #include <memory>
 
 #include "render/renderer.hpp"
+#include "support/render_fixture.hpp"
 
 namespace gvio::render {
 namespace {
 
-class RenderMapVoxels : public ::testing::Test {
+class RenderMapVoxels : public test::SharedRendererTest {
  protected:
-  static void SetUpTestSuite() {
-    context_ = std::make_unique<EglContext>();
-    renderer_ = std::make_unique<Renderer>(*context_);
-  }
-  static void TearDownTestSuite() {
-    renderer_.reset();
-    context_.reset();
-  }
   static ImageRgba draw(const Scene& s, const RenderCamera& cam) {
     const GpuScene gpu(s);
     Framebuffer fb(cam.width, cam.height);
     return renderer_->renderColor(gpu, cam, fb);
   }
-  static std::unique_ptr<EglContext> context_;
-  static std::unique_ptr<Renderer> renderer_;
 };
-std::unique_ptr<EglContext> RenderMapVoxels::context_;
-std::unique_ptr<Renderer> RenderMapVoxels::renderer_;
 
 // A seen-from-above voxel shows its top face, Lambert-lit from (0.3, 0.5, 0.8): if culling took
 // the wrong winding, the inside of the bottom face (ambient 0.45 only) would show instead.

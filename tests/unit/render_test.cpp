@@ -13,25 +13,12 @@
 #include "render/renderer.hpp"
 #include "sim/kitti_convention.hpp"
 #include "support/fixtures.hpp"
+#include "support/render_fixture.hpp"
 
 namespace gvio::render {
 namespace {
 
-class RenderTest : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    context_ = std::make_unique<EglContext>();
-    renderer_ = std::make_unique<Renderer>(*context_);
-  }
-  static void TearDownTestSuite() {
-    renderer_.reset();
-    context_.reset();
-  }
-  static std::unique_ptr<EglContext> context_;
-  static std::unique_ptr<Renderer> renderer_;
-};
-std::unique_ptr<EglContext> RenderTest::context_;
-std::unique_ptr<Renderer> RenderTest::renderer_;
+class RenderTest : public test::SharedRendererTest {};
 
 // KITTI's rectified camera: the simulator's.
 PinholeIntrinsics kittiCamera() {
