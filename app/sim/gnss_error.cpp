@@ -3,7 +3,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "fusion/geodesy.hpp"
 #include "odometry/error.hpp"
 
 namespace gvio::sim {
@@ -127,6 +126,15 @@ Eigen::Vector3d GnssErrorProcess::draw(std::int64_t t_ns, bool& outlier) {
   return error;
 }
 
+void reportAs(GnssFix& fix, const fusion::Lla& lla, const GnssErrorModel& model) {
+  fix.lat_deg = lla.lat_deg;
+  fix.lon_deg = lla.lon_deg;
+  fix.h_ellipsoid_m = lla.h_ellipsoid_m;
+  fix.sigma_h_m = model.reported_sigma_h_m;
+  fix.sigma_v_m = model.reported_sigma_v_m;
+  fix.quality = model.quality;
+}
+
 DegradedFixes degradeFixes(const std::vector<GnssFix>& fixes, const GnssErrorModel& model,
                            std::uint64_t seed) {
   model.validate();
@@ -141,12 +149,7 @@ DegradedFixes degradeFixes(const std::vector<GnssFix>& fixes, const GnssErrorMod
     const fusion::Lla lla =
         enu.toLla(enu.toEnu({fix.lat_deg, fix.lon_deg, fix.h_ellipsoid_m}) + error);
     GnssFix degraded = fix;
-    degraded.lat_deg = lla.lat_deg;
-    degraded.lon_deg = lla.lon_deg;
-    degraded.h_ellipsoid_m = lla.h_ellipsoid_m;
-    degraded.sigma_h_m = model.reported_sigma_h_m;
-    degraded.sigma_v_m = model.reported_sigma_v_m;
-    degraded.quality = model.quality;
+    reportAs(degraded, lla, model);
     out.fixes.push_back(degraded);
     out.added_error_enu.push_back(error);
     out.outliers += outlier ? 1 : 0;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "fusion/geodesy.hpp"
 #include "odometry/measurements.hpp"
 #include "sim/rng.hpp"
 
@@ -55,6 +56,10 @@ class GnssErrorProcess {
   Eigen::Vector3d bias_ = Eigen::Vector3d::Zero();
   std::int64_t t_ns_ = 0;
 };
+
+// Sets what a receiver of this model reports for a fix at `lla`: the position, the model's sigmas
+// and fix quality (time, HDOP and satellites are left as they are).
+void reportAs(GnssFix& fix, const fusion::Lla& lla, const GnssErrorModel& model);
 
 struct DegradedFixes {
   std::vector<GnssFix> fixes;

@@ -51,15 +51,9 @@ Geometry geometryAt(const GnssErrorModel& m, double t_s, double phase) {
 
 GnssFix reportedFix(std::int64_t t_ns, const Eigen::Vector3d& p_enu, const Geometry& geometry,
                     const GnssErrorModel& m, const fusion::EnuFrame& enu) {
-  const fusion::Lla lla = enu.toLla(p_enu);
   GnssFix fix;
   fix.t_ns = t_ns;
-  fix.lat_deg = lla.lat_deg;
-  fix.lon_deg = lla.lon_deg;
-  fix.h_ellipsoid_m = lla.h_ellipsoid_m;
-  fix.sigma_h_m = m.reported_sigma_h_m;
-  fix.sigma_v_m = m.reported_sigma_v_m;
-  fix.quality = m.quality;
+  reportAs(fix, enu.toLla(p_enu), m);
   fix.hdop = geometry.hdop;
   fix.num_sats = geometry.num_sats;
   return fix;
