@@ -1,5 +1,8 @@
 #include "fusion/gnss_factors.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "odometry/lie.hpp"
 #include "odometry/pose_manifold.hpp"
 
@@ -64,6 +67,44 @@ bool GnssPositionFactor::Evaluate(double const* const* parameters, double* resid
     J << inv_sigma_.asDiagonal() * (-R * hat(q_b_)), inv_sigma_.asDiagonal() * R;
     Eigen::Map<Eigen::Matrix<double, 3, 7, Eigen::RowMajor>>{jacobians[0]} =
         J * poseMinusJacobian(parameters[0]);
+  }
+  return true;
+}
+
+GnssBiasedPositionFactor::GnssBiasedPositionFactor(const Eigen::Vector3d& q_b,
+                                                   const Eigen::Vector3d& p_enu_fix,
+                                                   double sigma_h_m, double sigma_v_m)
+    : position_(q_b, p_enu_fix, sigma_h_m, sigma_v_m),
+      inv_sigma_(1.0 / sigma_h_m, 1.0 / sigma_h_m, 1.0 / sigma_v_m) {}
+
+bool GnssBiasedPositionFactor::Evaluate(double const* const* parameters, double* residuals,
+                                        double** jacobians) const {
+  double* pose_jacobian[1] = {jacobians != nullptr ? jacobians[0] : nullptr};
+  position_.Evaluate(parameters, residuals, jacobians != nullptr ? pose_jacobian : nullptr);
+  const Eigen::Map<const Eigen::Vector3d> b(parameters[1]);
+  Eigen::Map<Eigen::Vector3d>{residuals} += inv_sigma_.cwiseProduct(b);
+  if (jacobians != nullptr && jacobians[1] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>{jacobians[1]} =
+        inv_sigma_.asDiagonal();
+  }
+  return true;
+}
+
+GaussMarkovFactor::GaussMarkovFactor(double dt_s, double tau_s, double sigma)
+    : phi_(std::exp(-dt_s / tau_s)),
+      // A floor on the driving noise keeps the factor finite for coincident states (dt = 0).
+      inv_sigma_w_(1.0 / std::max(sigma * std::sqrt(1.0 - phi_ * phi_), 1e-6 * sigma)) {}
+
+bool GaussMarkovFactor::Evaluate(double const* const* parameters, double* residuals,
+                                 double** jacobians) const {
+  const Eigen::Map<const Eigen::Vector3d> b_i(parameters[0]), b_j(parameters[1]);
+  Eigen::Map<Eigen::Vector3d>{residuals} = inv_sigma_w_ * (b_j - phi_ * b_i);
+  using Jac3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+  if (jacobians != nullptr && jacobians[0] != nullptr) {
+    Eigen::Map<Jac3>{jacobians[0]} = -inv_sigma_w_ * phi_ * Eigen::Matrix3d::Identity();
+  }
+  if (jacobians != nullptr && jacobians[1] != nullptr) {
+    Eigen::Map<Jac3>{jacobians[1]} = inv_sigma_w_ * Eigen::Matrix3d::Identity();
   }
   return true;
 }

@@ -38,4 +38,31 @@ class GnssPositionFactor final : public ceres::SizedCostFunction<3, 7> {
   Eigen::Vector3d inv_sigma_;
 };
 
+// A GNSS fix with the receiver's correlated error as a state b (fusion/gnss_smoother.hpp):
+//   r = diag(1/sigma_h, 1/sigma_h, 1/sigma_v) (p_i + R_i q_b + b - p_enu_fix).
+class GnssBiasedPositionFactor final : public ceres::SizedCostFunction<3, 7, 3> {
+ public:
+  GnssBiasedPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix,
+                           double sigma_h_m, double sigma_v_m);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  GnssPositionFactor position_;
+  Eigen::Vector3d inv_sigma_;
+};
+
+// First-order Gauss-Markov process between two bias states dt apart (Groves 2013, App. I):
+//   b_j = phi b_i + w, phi = exp(-dt / tau), var(w) = sigma^2 (1 - phi^2);
+//   r = (b_j - phi b_i) / sqrt(var(w)).
+class GaussMarkovFactor final : public ceres::SizedCostFunction<3, 3, 3> {
+ public:
+  GaussMarkovFactor(double dt_s, double tau_s, double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  double phi_, inv_sigma_w_;
+};
+
 }  // namespace gvio::fusion

@@ -74,6 +74,7 @@ void FusionConfig::validate() const {
   }
   positive(outage_s, "outage_s");
   kf.validate();
+  smoother.validate();
 }
 
 struct GnssFusion::Impl {
@@ -95,10 +96,13 @@ struct GnssFusion::Impl {
   Eigen::Isometry3d fusedPose(std::int64_t t_ns, const Eigen::Isometry3d& T_w_b) const;
   void noteAccepted(std::int64_t t_ns);
   void noteOutcome(const Pair& pair, bool used);
+  void noteGraphNode(const Pair& pair);
+  void smooth();
 
   FusionConfig config;
   EnuFrame enu;
-  Trajectory vio, fused;
+  Trajectory vio, fused, smoothed;
+  std::vector<SmootherFix> graph_fixes;  // every fix the graph used, for the smoothing pass
   std::deque<GnssFix> pending;
   std::vector<Pair> alignment_pairs;
   std::optional<Eigen::Isometry3d> T_enu_w;
@@ -192,6 +196,7 @@ bool GnssFusion::Impl::fuseGraph(const Pair& pair) {
     graph.addGnssFactor(n, std::make_shared<GnssPositionFactor>(
                                lever, pair.p_enu, pair.fix.sigma_h_m, pair.fix.sigma_v_m));
     graph.solve();
+    noteGraphNode(pair);
     return true;
   }
   const GraphNode& last = graph.newest();
@@ -218,7 +223,26 @@ bool GnssFusion::Impl::fuseGraph(const Pair& pair) {
   graph.addGnssFactor(n, std::make_shared<GnssPositionFactor>(lever, pair.p_enu, pair.fix.sigma_h_m,
                                                               pair.fix.sigma_v_m));
   graph.solve();
+  noteGraphNode(pair);
   return true;
+}
+
+void GnssFusion::Impl::noteGraphNode(const Pair& pair) {
+  graph_fixes.push_back({pair.t_ns, pair.T_w_b, graph.newest().T_enu_b(), pair.p_enu,
+                         pair.fix.sigma_h_m, pair.fix.sigma_v_m});
+}
+
+void GnssFusion::Impl::smooth() {
+  if (config.mode != FusionMode::kGraph || !config.smoother.enabled || graph_fixes.size() < 2) {
+    return;
+  }
+  const auto start = Clock::now();
+  const RelativeNoise noise{config.vio_drift_fraction, config.vio_sigma_floor_m,
+                            config.vio_rot_drift_rad_per_m, config.vio_rot_floor_rad};
+  const std::vector<Eigen::Isometry3d> nodes =
+      smoothNodes(graph_fixes, config.lever_arm_b, noise, config.huber_sigmas, config.smoother);
+  smoothed = spreadOverVio(vio, graph_fixes, nodes);
+  stats.ms_smoothing = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
 bool GnssFusion::Impl::fuseKf(const Pair& pair) {
@@ -326,10 +350,14 @@ void GnssFusion::finish() {
       static_cast<double>(s.vio.t_ns.back() - *s.last_accepted_ns) * 1e-9 > s.config.outage_s) {
     s.stats.outages.emplace_back(*s.last_accepted_ns, s.vio.t_ns.back());
   }
+  s.smooth();
 }
 
 Trajectory GnssFusion::fusedTrajectory() const {
   return impl_->fused;
+}
+Trajectory GnssFusion::smoothedTrajectory() const {
+  return impl_->smoothed;
 }
 const FusionStats& GnssFusion::stats() const {
   return impl_->stats;

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "fusion/geodesy.hpp"
+#include "fusion/gnss_smoother.hpp"
 #include "fusion/kf_baseline.hpp"
 #include "fusion/vio_enu_alignment.hpp"
 #include "odometry/measurements.hpp"
@@ -53,7 +54,8 @@ struct FusionConfig {
   int max_consecutive_rejections = 5;  // then the next fix is accepted (re-convergence)
   double outage_s = 3.0;               // no accepted fix for longer than this is an outage
   KfConfig kf;
-  void validate() const;  // throws InvalidInput naming the field
+  SmootherConfig smoother;  // graph mode: the offline pass after the drive
+  void validate() const;    // throws InvalidInput naming the field
 };
 
 // What became of one screened fix.
@@ -79,6 +81,7 @@ struct FusionStats {
   std::vector<std::pair<std::int64_t, std::int64_t>> outages;  // [t0, t1] without accepted fixes
   std::vector<double> ms_per_fix;  // fusion cost of each processed fix (informational)
   std::vector<FixOutcome> fixes;   // every screened fix in time order (maps, plots)
+  double ms_smoothing = 0.0;       // the offline smoothing pass (graph mode), 0 when not run
 };
 
 class GnssFusion {
@@ -95,8 +98,12 @@ class GnssFusion {
   // Processes the fixes still waiting and closes the last outage.
   void finish();
 
-  // T_enu_b of every VIO pose added (empty until the first registration succeeds).
+  // T_enu_b of every VIO pose added, as known when it was added (causal; empty until the first
+  // registration succeeds).
   [[nodiscard]] Trajectory fusedTrajectory() const;
+  // After finish(), graph mode with the smoother enabled and >= 2 fixes used: T_enu_b of every VIO
+  // pose from the batch smoothing pass over all fixes (fusion/gnss_smoother.hpp); else empty.
+  [[nodiscard]] Trajectory smoothedTrajectory() const;
   [[nodiscard]] const FusionStats& stats() const;
   [[nodiscard]] std::optional<Eigen::Isometry3d> T_enu_w() const;
 

@@ -153,12 +153,16 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
   context.evaluation = evaluation ? &*evaluation : nullptr;
   context.gnss = gnss ? &*gnss : nullptr;
   // Without alignment the truth must be in the same ENU frame: only with an explicit origin.
-  std::optional<run::UnalignedOutcome> evaluation_fused;
+  std::optional<run::UnalignedOutcome> evaluation_fused, evaluation_fused_online;
   if (gnss && ds.groundtruth && ds.groundtruth->hasTimestamps() && !gnss->fused.empty() &&
       config.fusion.originLla()) {
     evaluation_fused = run::evaluateUnaligned(*ds.groundtruth, gnss->fused);
+    if (!gnss->fused_online.empty()) {
+      evaluation_fused_online = run::evaluateUnaligned(*ds.groundtruth, gnss->fused_online);
+    }
   }
   context.evaluation_fused = evaluation_fused ? &*evaluation_fused : nullptr;
+  context.evaluation_fused_online = evaluation_fused_online ? &*evaluation_fused_online : nullptr;
   io::writeTextAtomic(out / "report.json", run::buildReport(ds, result, context).dump(2) + "\n");
   io::writeTextAtomic(out / "config.yaml", dumpConfigYaml(config));
 
@@ -175,6 +179,9 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
     if (evaluation_fused && evaluation_fused->ape) {
       fused_ape =
           fmt::format(", fused APE (no alignment) rmse {:.3f} m", evaluation_fused->ape->rmse);
+      if (evaluation_fused_online && evaluation_fused_online->ape) {
+        fused_ape += fmt::format(" smoothed, {:.3f} m online", evaluation_fused_online->ape->rmse);
+      }
     }
     spdlog::info("GNSS {}: {} fixes used, {} rejected, {} skipped, {} outage(s){}",
                  fusion::toString(gnss->mode), gnss->stats.fixes_used, gnss->stats.fixes_rejected,

@@ -46,7 +46,12 @@ std::optional<GnssRunResult> fuseGnss(const io::Dataset& ds, const Trajectory& v
   while (f < screened.fixes.size()) fusion.addFix(screened.fixes[f++]);
   fusion.finish();
   r.stats = fusion.stats();
-  r.fused = fusion.fusedTrajectory();
+  r.fused = fusion.smoothedTrajectory();
+  if (r.fused.empty()) {
+    r.fused = fusion.fusedTrajectory();
+  } else {
+    r.fused_online = fusion.fusedTrajectory();
+  }
   r.T_enu_w = fusion.T_enu_w();
   if (!r.T_enu_w) {
     spdlog::warn(
@@ -71,6 +76,7 @@ void writeGeoreferencedOutputs(const std::filesystem::path& out, const GnssRunRe
   writeGnssFixes(out / "gnss_fixes.csv", r);
   if (r.fused.empty()) return;
   io::writeTum(out / "trajectory.tum", r.fused);
+  if (!r.fused_online.empty()) io::writeTum(out / "trajectory_online.tum", r.fused_online);
   const fusion::EnuFrame enu(r.origin);
   io::writeFileAtomic(out / "trajectory_lla.csv", [&](std::ostream& os) {
     os << "# t_s,lat_deg,lon_deg,h_ellipsoid_m,qw,qx,qy,qz (body in local ENU)\n";
@@ -125,6 +131,8 @@ nlohmann::json gnssReport(const GnssRunResult& r, std::size_t fixes_in_dataset) 
             {"outside_drive", r.screening.outside_drive},
             {"out_of_order", r.screening.out_of_order}}},
           {"registered", r.T_enu_w.has_value()},
+          {"smoothed", !r.fused_online.empty()},
+          {"ms_smoothing", r.stats.ms_smoothing},
           {"poses_before_registration", r.stats.poses_before_alignment},
           {"ms_per_fix", {{"mean", cost.mean}, {"p95", cost.p95}, {"max", cost.max}}},
           {"enu_origin",

@@ -20,7 +20,10 @@ struct GnssRunResult {
   fusion::Lla origin;  // of the local ENU frame
   fusion::ScreeningCounts screening;
   fusion::FusionStats stats;
-  Trajectory fused;  // T_enu_b, empty when the registration to ENU never succeeded
+  // T_enu_b, empty when the registration to ENU never succeeded: the smoothed trajectory when the
+  // smoothing pass ran (graph mode), else the causal one.
+  Trajectory fused;
+  Trajectory fused_online;  // the causal T_enu_b, only when `fused` is the smoothed one
   std::optional<Eigen::Isometry3d> T_enu_w;
 };
 
@@ -35,7 +38,8 @@ std::optional<GnssRunResult> fuseGnss(const io::Dataset& dataset, const Trajecto
 void writeGnssFixes(const std::filesystem::path& file, const GnssRunResult& result);
 
 // gnss_fixes.csv, and when the fusion registered: trajectory.tum (T_enu_b), trajectory_lla.csv (t,
-// lat, lon, h, qw qx qy qz of the body in ENU) and georef.json, all atomically.
+// lat, lon, h, qw qx qy qz of the body in ENU), georef.json and, when trajectory.tum is the
+// smoothed one, trajectory_online.tum (causal), all atomically.
 void writeGeoreferencedOutputs(const std::filesystem::path& out, const GnssRunResult& result);
 
 // report.json's "gnss" object and "outages" array.

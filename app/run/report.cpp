@@ -95,6 +95,13 @@ json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportCon
                       "no alignment, in the ENU frame of fusion.origin (the truth's must "
                       "match)"}}
               : json{{"error", e.error}};
+    const UnalignedOutcome* online = ctx.evaluation_fused_online;
+    if (e.ape && online && online->ape) {
+      report["evaluation_fused"]["ape_none_online"] = statsJson(*online->ape);
+      report["evaluation_fused"]["trajectory"] =
+          "ape_none: trajectory.tum (smoothed over all fixes); ape_none_online: "
+          "trajectory_online.tum (causal)";
+    }
   }
   return report;
 }

@@ -22,6 +22,8 @@ struct ReportContext {
   const EvaluationOutcome* evaluation = nullptr;       // null: the dataset has no ground truth
   const GnssRunResult* gnss = nullptr;                 // null: no GNSS fusion ran
   const UnalignedOutcome* evaluation_fused = nullptr;  // null: not evaluated
+  // The causal (online) fused trajectory when trajectory.tum is the smoothed one; else null.
+  const UnalignedOutcome* evaluation_fused_online = nullptr;
 };
 
 nlohmann::json buildReport(const io::Dataset& dataset, const VioRunResult& run,

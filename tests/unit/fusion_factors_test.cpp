@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 
 #include "fusion/gnss_factors.hpp"
 #include "odometry/lie.hpp"
@@ -62,6 +63,45 @@ TEST(GnssPositionFactor, ZeroAtTheAntennaAndJacobian) {
   const auto num = numericTangentJacobian<3>(off, blocks, 0, true);
   const auto ana = analyticTangentJacobian<3>(off, blocks, 0, true);
   EXPECT_LT((num - ana).norm(), 1e-5 * std::max(1.0, ana.norm()));
+}
+
+TEST(GnssBiasedPositionFactor, ZeroAtTheBiasedAntennaAndJacobians) {
+  std::vector<std::vector<double>> blocks = {
+      poseBlock(Eigen::Vector3d(0.02, -0.01, 2.0), Eigen::Vector3d(100, 50, 3)), {0.7, -0.4, 1.1}};
+  const Eigen::Isometry3d T = odometry::poseFromBlock(blocks[0].data());
+  const Eigen::Vector3d q_b(1.2, 0.3, 1.5);
+  const Eigen::Vector3d b(blocks[1][0], blocks[1][1], blocks[1][2]);
+  const GnssBiasedPositionFactor exact(q_b, T * q_b + b, 1.5, 3.0);
+  const double* params[] = {blocks[0].data(), blocks[1].data()};
+  Eigen::Vector3d r;
+  ASSERT_TRUE(exact.Evaluate(params, r.data(), nullptr));
+  EXPECT_LT(r.norm(), 1e-9);
+  const GnssBiasedPositionFactor off(q_b, T * q_b + b + Eigen::Vector3d(1.5, 0.0, 3.0), 1.5, 3.0);
+  ASSERT_TRUE(off.Evaluate(params, r.data(), nullptr));
+  EXPECT_LT((r - Eigen::Vector3d(-1, 0, -1)).norm(), 1e-9);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto num = numericTangentJacobian<3>(off, blocks, k, k == 0);
+    const auto ana = analyticTangentJacobian<3>(off, blocks, k, k == 0);
+    EXPECT_LT((num - ana).norm(), 1e-5 * std::max(1.0, ana.norm())) << "block " << k;
+  }
+}
+
+TEST(GaussMarkovFactor, WhitensTheProcessNoiseAndJacobians) {
+  // dt = tau: phi = 1/e, var(w) = sigma^2 (1 - e^-2).
+  const GaussMarkovFactor factor(30.0, 30.0, 2.0);
+  std::vector<std::vector<double>> blocks = {{1.0, -2.0, 0.5}, {0.3, 0.1, -0.4}};
+  const double* params[] = {blocks[0].data(), blocks[1].data()};
+  Eigen::Vector3d r;
+  ASSERT_TRUE(factor.Evaluate(params, r.data(), nullptr));
+  const double phi = std::exp(-1.0), sigma_w = 2.0 * std::sqrt(1.0 - phi * phi);
+  const Eigen::Vector3d expected =
+      (Eigen::Vector3d(0.3, 0.1, -0.4) - phi * Eigen::Vector3d(1.0, -2.0, 0.5)) / sigma_w;
+  EXPECT_LT((r - expected).norm(), 1e-12);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto num = numericTangentJacobian<3>(factor, blocks, k, false);
+    const auto ana = analyticTangentJacobian<3>(factor, blocks, k, false);
+    EXPECT_LT((num - ana).norm(), 1e-6 * std::max(1.0, ana.norm())) << "block " << k;
+  }
 }
 
 }  // namespace

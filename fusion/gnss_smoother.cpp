@@ -1,0 +1,131 @@
+#include "fusion/gnss_smoother.hpp"
+
+#include <array>
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include <ceres/loss_function.h>
+#include <ceres/normal_prior.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include "fusion/gnss_factors.hpp"
+#include "odometry/error.hpp"
+#include "odometry/pose_manifold.hpp"
+
+namespace gvio::fusion {
+namespace {
+
+ceres::LinearSolverType sparseOrDense() {
+  const bool sparse = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ||
+                      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE);
+  // The graph is a chain (block tridiagonal): sparse Cholesky keeps hours of fixes cheap.
+  return sparse ? ceres::SPARSE_NORMAL_CHOLESKY : ceres::DENSE_QR;
+}
+
+}  // namespace
+
+void SmootherConfig::validate() const {
+  if (!(std::isfinite(bias_ratio) && bias_ratio >= 0.0)) {
+    throw InvalidInput("config: fusion.smoother.bias_ratio must be >= 0");
+  }
+  if (!(std::isfinite(bias_tau_s) && bias_tau_s > 0.0)) {
+    throw InvalidInput("config: fusion.smoother.bias_tau_s must be > 0");
+  }
+  if (max_iterations < 1) throw InvalidInput("config: fusion.smoother.max_iterations must be >= 1");
+}
+
+std::vector<Eigen::Isometry3d> smoothNodes(const std::vector<SmootherFix>& fixes,
+                                           const Eigen::Vector3d& lever_arm_b,
+                                           const RelativeNoise& noise, double huber_sigmas,
+                                           const SmootherConfig& config) {
+  const std::size_t n = fixes.size();
+  std::vector<std::array<double, odometry::kPoseAmbient>> poses(n);
+  std::vector<Eigen::Vector3d> biases(n, Eigen::Vector3d::Zero());
+  const bool with_bias = config.bias_ratio > 0.0;
+  odometry::PoseManifold manifold;
+  ceres::HuberLoss loss(huber_sigmas);
+  ceres::Problem::Options popts;
+  popts.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  popts.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(popts);
+  for (std::size_t k = 0; k < n; ++k) {
+    const SmootherFix& f = fixes[k];
+    odometry::poseToBlock(f.T_enu_b, poses[k].data());
+    problem.AddParameterBlock(poses[k].data(), odometry::kPoseAmbient, &manifold);
+    if (with_bias) {
+      problem.AddResidualBlock(
+          new GnssBiasedPositionFactor(lever_arm_b, f.p_enu, f.sigma_h_m, f.sigma_v_m), &loss,
+          poses[k].data(), biases[k].data());
+    } else {
+      problem.AddResidualBlock(
+          new GnssPositionFactor(lever_arm_b, f.p_enu, f.sigma_h_m, f.sigma_v_m), &loss,
+          poses[k].data());
+    }
+    if (k == 0) continue;
+    const Eigen::Isometry3d T_rel = fixes[k - 1].T_w_b.inverse() * f.T_w_b;
+    const double dist = T_rel.translation().norm();
+    problem.AddResidualBlock(
+        new RelativePoseFactor(T_rel, noise.rot_drift_rad_per_m * dist + noise.rot_floor_rad,
+                               noise.drift_fraction * dist + noise.sigma_floor_m),
+        nullptr, poses[k - 1].data(), poses[k].data());
+    if (with_bias) {
+      const double dt = static_cast<double>(f.t_ns - fixes[k - 1].t_ns) * 1e-9;
+      problem.AddResidualBlock(
+          new GaussMarkovFactor(dt, config.bias_tau_s, config.bias_ratio * f.sigma_h_m), nullptr,
+          biases[k - 1].data(), biases[k].data());
+    }
+  }
+  if (with_bias && n > 0) {
+    // The stationary distribution of the bias at the first fix: N(0, sigma^2 I).
+    const Eigen::Matrix3d A =
+        Eigen::Matrix3d::Identity() / (config.bias_ratio * fixes.front().sigma_h_m);
+    problem.AddResidualBlock(new ceres::NormalPrior(A, Eigen::Vector3d::Zero()), nullptr,
+                             biases[0].data());
+  }
+  ceres::Solver::Options options;
+  options.linear_solver_type = sparseOrDense();
+  options.max_num_iterations = config.max_iterations;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  std::vector<Eigen::Isometry3d> out;
+  out.reserve(n);
+  for (const auto& p : poses) out.push_back(odometry::poseFromBlock(p.data()));
+  return out;
+}
+
+Trajectory spreadOverVio(const Trajectory& vio, const std::vector<SmootherFix>& nodes,
+                         const std::vector<Eigen::Isometry3d>& smoothed) {
+  Trajectory out;
+  const std::size_t n = nodes.size();
+  if (n == 0 || smoothed.size() != n) return out;
+  out.t_ns = vio.t_ns;
+  out.poses.reserve(vio.size());
+  std::size_t i = 0;  // the last node at or before the pose (or the first node)
+  for (std::size_t k = 0; k < vio.size(); ++k) {
+    const std::int64_t t = vio.t_ns[k];
+    while (i + 1 < n && nodes[i + 1].t_ns <= t) ++i;
+    const auto carried = [&](std::size_t j) {
+      return Eigen::Isometry3d(smoothed[j] * nodes[j].T_w_b.inverse() * vio.poses[k]);
+    };
+    if (t <= nodes[0].t_ns || i + 1 >= n) {
+      out.poses.push_back(carried(t <= nodes[0].t_ns ? 0 : n - 1));
+      continue;
+    }
+    const Eigen::Isometry3d A = carried(i), B = carried(i + 1);
+    const double alpha = static_cast<double>(t - nodes[i].t_ns) /
+                         static_cast<double>(nodes[i + 1].t_ns - nodes[i].t_ns);
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::Quaterniond(A.rotation())
+                     .slerp(alpha, Eigen::Quaterniond(B.rotation()))
+                     .toRotationMatrix();
+    T.translation() = (1.0 - alpha) * A.translation() + alpha * B.translation();
+    out.poses.push_back(T);
+  }
+  return out;
+}
+
+}  // namespace gvio::fusion

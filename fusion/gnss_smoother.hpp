@@ -1,0 +1,64 @@
+#pragma once
+// Offline smoothing pass of the global fusion ("graph" mode): after the drive, one batch solve
+// over every accepted fix (nodes at the fix times, VIO relative-pose factors between consecutive
+// nodes, robust GNSS position factors) gives each node the estimate that uses the fixes after it as
+// well as those before (a fixed-interval smoother; the online window only sees the past). The VIO
+// poses between two nodes take the blend of the two nodes carried by the VIO motion, so the VIO's
+// own shape is kept between fixes.
+//
+// Optionally the receiver's slowly varying error (multipath, atmosphere: SPP errors are strongly
+// correlated over tens of seconds) is modelled as a first-order Gauss-Markov bias per axis,
+//   b_{k+1} = phi b_k + w_k, phi = exp(-dt / tau), var(w_k) = sigma_b^2 (1 - phi^2)
+// (Groves 2013, "Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems",
+// 2nd ed., eq. 14.74 / App. I), with the fix p_fix = p_antenna + b + white noise. Without it a
+// correlated error is taken for truth by every fix it touches.
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <vector>
+
+#include "odometry/trajectory.hpp"
+
+namespace gvio::fusion {
+
+struct SmootherConfig {
+  bool enabled = true;
+  // Gauss-Markov receiver bias per axis: its steady-state sigma as a fraction of the fix's reported
+  // horizontal sigma (receivers report their white noise; the correlated part scales with it:
+  // SPP ~1 m, RTK ~1 cm); 0 leaves the bias out of the model.
+  double bias_ratio = 0.5;
+  double bias_tau_s = 60.0;
+  int max_iterations = 50;
+  void validate() const;  // throws InvalidInput naming the field
+};
+
+// One accepted fix with what the online fusion knew of it.
+struct SmootherFix {
+  std::int64_t t_ns = 0;
+  Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();    // VIO pose at the fix time
+  Eigen::Isometry3d T_enu_b = Eigen::Isometry3d::Identity();  // online estimate (initial guess)
+  Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();            // antenna position of the fix
+  double sigma_h_m = 1.0, sigma_v_m = 1.0;
+};
+
+// The VIO relative-motion noise between nodes: sigma = fraction * distance + floor (rotation:
+// rad per metre + floor), as the online window uses.
+struct RelativeNoise {
+  double drift_fraction = 0.004;
+  double sigma_floor_m = 0.02;
+  double rot_drift_rad_per_m = 1e-5;
+  double rot_floor_rad = 5e-4;
+};
+
+// The smoothed body pose T_enu_b at each fix (same order). `lever_arm_b`: antenna in the body.
+std::vector<Eigen::Isometry3d> smoothNodes(const std::vector<SmootherFix>& fixes,
+                                           const Eigen::Vector3d& lever_arm_b,
+                                           const RelativeNoise& noise, double huber_sigmas,
+                                           const SmootherConfig& config);
+
+// Every VIO pose in ENU: between nodes i and i+1 the two nodes carried by the VIO motion, blended
+// linearly in time (slerp for the rotation); before the first / after the last node, that node
+// carried by the VIO. `nodes` must be in time order with `smoothed` of the same size (>= 1).
+Trajectory spreadOverVio(const Trajectory& vio, const std::vector<SmootherFix>& nodes,
+                         const std::vector<Eigen::Isometry3d>& smoothed);
+
+}  // namespace gvio::fusion
