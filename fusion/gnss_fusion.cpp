@@ -102,6 +102,7 @@ struct GnssFusion::Impl {
   FusionConfig config;
   EnuFrame enu;
   Trajectory vio, fused, smoothed;
+  std::vector<PoseCovariance> smoothed_covariance;
   std::vector<SmootherFix> graph_fixes;  // every fix the graph used, for the smoothing pass
   std::deque<GnssFix> pending;
   std::vector<Pair> alignment_pairs;
@@ -239,9 +240,9 @@ void GnssFusion::Impl::smooth() {
   const auto start = Clock::now();
   const RelativeNoise noise{config.vio_drift_fraction, config.vio_sigma_floor_m,
                             config.vio_rot_drift_rad_per_m, config.vio_rot_floor_rad};
-  const std::vector<Eigen::Isometry3d> nodes =
+  const SmoothedNodes nodes =
       smoothNodes(graph_fixes, config.lever_arm_b, noise, config.huber_sigmas, config.smoother);
-  smoothed = spreadOverVio(vio, graph_fixes, nodes);
+  smoothed = spreadOverVio(vio, graph_fixes, nodes, noise, &smoothed_covariance);
   stats.ms_smoothing = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
@@ -358,6 +359,9 @@ Trajectory GnssFusion::fusedTrajectory() const {
 }
 Trajectory GnssFusion::smoothedTrajectory() const {
   return impl_->smoothed;
+}
+const std::vector<PoseCovariance>& GnssFusion::smoothedCovariance() const {
+  return impl_->smoothed_covariance;
 }
 const FusionStats& GnssFusion::stats() const {
   return impl_->stats;

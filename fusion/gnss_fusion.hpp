@@ -104,6 +104,9 @@ class GnssFusion {
   // After finish(), graph mode with the smoother enabled and >= 2 fixes used: T_enu_b of every VIO
   // pose from the batch smoothing pass over all fixes (fusion/gnss_smoother.hpp); else empty.
   [[nodiscard]] Trajectory smoothedTrajectory() const;
+  // The covariance of each smoothed pose (fusion/gnss_smoother.hpp PoseCovariance), empty when
+  // there is no smoothed trajectory or the covariance could not be computed.
+  [[nodiscard]] const std::vector<PoseCovariance>& smoothedCovariance() const;
   [[nodiscard]] const FusionStats& stats() const;
   [[nodiscard]] std::optional<Eigen::Isometry3d> T_enu_w() const;
 

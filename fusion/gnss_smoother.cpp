@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include <ceres/covariance.h>
 #include <ceres/loss_function.h>
 #include <ceres/normal_prior.h>
 #include <ceres/problem.h>
@@ -24,6 +25,30 @@ ceres::LinearSolverType sparseOrDense() {
   return sparse ? ceres::SPARSE_NORMAL_CHOLESKY : ceres::DENSE_QR;
 }
 
+// Marginal covariances of the node poses, rotated from the manifold's body-frame tangent
+// (dphi, dp_body) to ENU axes: dtheta = R dphi, dp = R dp_body.
+std::vector<PoseCovariance> nodeCovariances(
+    ceres::Problem& problem, const std::vector<std::array<double, odometry::kPoseAmbient>>& poses) {
+  ceres::Covariance::Options options;
+  options.num_threads = 1;
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (const auto& p : poses) blocks.emplace_back(p.data(), p.data());
+  if (!covariance.Compute(blocks, &problem)) return {};
+  std::vector<PoseCovariance> out;
+  out.reserve(poses.size());
+  for (const auto& p : poses) {
+    Eigen::Matrix<double, 6, 6, Eigen::RowMajor> tangent;
+    if (!covariance.GetCovarianceBlockInTangentSpace(p.data(), p.data(), tangent.data())) return {};
+    const Eigen::Matrix3d R = odometry::poseFromBlock(p.data()).rotation();
+    Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
+    J.topLeftCorner<3, 3>() = R;
+    J.bottomRightCorner<3, 3>() = R;
+    out.push_back(J * tangent * J.transpose());
+  }
+  return out;
+}
+
 }  // namespace
 
 void SmootherConfig::validate() const {
@@ -36,10 +61,9 @@ void SmootherConfig::validate() const {
   if (max_iterations < 1) throw InvalidInput("config: fusion.smoother.max_iterations must be >= 1");
 }
 
-std::vector<Eigen::Isometry3d> smoothNodes(const std::vector<SmootherFix>& fixes,
-                                           const Eigen::Vector3d& lever_arm_b,
-                                           const RelativeNoise& noise, double huber_sigmas,
-                                           const SmootherConfig& config) {
+SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Vector3d& lever_arm_b,
+                          const RelativeNoise& noise, double huber_sigmas,
+                          const SmootherConfig& config) {
   const std::size_t n = fixes.size();
   std::vector<std::array<double, odometry::kPoseAmbient>> poses(n);
   std::vector<Eigen::Vector3d> biases(n, Eigen::Vector3d::Zero());
@@ -91,17 +115,32 @@ std::vector<Eigen::Isometry3d> smoothNodes(const std::vector<SmootherFix>& fixes
   options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
-  std::vector<Eigen::Isometry3d> out;
-  out.reserve(n);
-  for (const auto& p : poses) out.push_back(odometry::poseFromBlock(p.data()));
+  SmoothedNodes out;
+  out.T_enu_b.reserve(n);
+  for (const auto& p : poses) out.T_enu_b.push_back(odometry::poseFromBlock(p.data()));
+  out.covariance = nodeCovariances(problem, poses);
   return out;
 }
 
 Trajectory spreadOverVio(const Trajectory& vio, const std::vector<SmootherFix>& nodes,
-                         const std::vector<Eigen::Isometry3d>& smoothed) {
+                         const SmoothedNodes& smoothed_nodes, const RelativeNoise& noise,
+                         std::vector<PoseCovariance>* covariance_out) {
   Trajectory out;
+  const std::vector<Eigen::Isometry3d>& smoothed = smoothed_nodes.T_enu_b;
   const std::size_t n = nodes.size();
   if (n == 0 || smoothed.size() != n) return out;
+  const bool with_covariance = covariance_out != nullptr && smoothed_nodes.covariance.size() == n;
+  if (covariance_out != nullptr) covariance_out->clear();
+  // The VIO's drift between a node and the pose, as the relative factors model it.
+  const auto drift = [&](std::size_t j, std::size_t k) {
+    const double d = (nodes[j].T_w_b.translation() - vio.poses[k].translation()).norm();
+    const double s_rot = noise.rot_drift_rad_per_m * d + noise.rot_floor_rad;
+    const double s_pos = noise.drift_fraction * d + noise.sigma_floor_m;
+    PoseCovariance q = PoseCovariance::Zero();
+    q.diagonal() << s_rot * s_rot, s_rot * s_rot, s_rot * s_rot, s_pos * s_pos, s_pos * s_pos,
+        s_pos * s_pos;
+    return q;
+  };
   out.t_ns = vio.t_ns;
   out.poses.reserve(vio.size());
   std::size_t i = 0;  // the last node at or before the pose (or the first node)
@@ -112,7 +151,9 @@ Trajectory spreadOverVio(const Trajectory& vio, const std::vector<SmootherFix>& 
       return Eigen::Isometry3d(smoothed[j] * nodes[j].T_w_b.inverse() * vio.poses[k]);
     };
     if (t <= nodes[0].t_ns || i + 1 >= n) {
-      out.poses.push_back(carried(t <= nodes[0].t_ns ? 0 : n - 1));
+      const std::size_t j = t <= nodes[0].t_ns ? 0 : n - 1;
+      out.poses.push_back(carried(j));
+      if (with_covariance) covariance_out->push_back(smoothed_nodes.covariance[j] + drift(j, k));
       continue;
     }
     const Eigen::Isometry3d A = carried(i), B = carried(i + 1);
@@ -124,6 +165,11 @@ Trajectory spreadOverVio(const Trajectory& vio, const std::vector<SmootherFix>& 
                      .toRotationMatrix();
     T.translation() = (1.0 - alpha) * A.translation() + alpha * B.translation();
     out.poses.push_back(T);
+    if (with_covariance) {
+      const std::size_t nearer = alpha < 0.5 ? i : i + 1;
+      covariance_out->push_back((1.0 - alpha) * smoothed_nodes.covariance[i] +
+                                alpha * smoothed_nodes.covariance[i + 1] + drift(nearer, k));
+    }
   }
   return out;
 }

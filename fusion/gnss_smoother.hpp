@@ -49,16 +49,29 @@ struct RelativeNoise {
   double rot_floor_rad = 5e-4;
 };
 
-// The smoothed body pose T_enu_b at each fix (same order). `lever_arm_b`: antenna in the body.
-std::vector<Eigen::Isometry3d> smoothNodes(const std::vector<SmootherFix>& fixes,
-                                           const Eigen::Vector3d& lever_arm_b,
-                                           const RelativeNoise& noise, double huber_sigmas,
-                                           const SmootherConfig& config);
+// Covariance of a pose in ENU-aligned axes: (rotation about E, N, U (rad); position E, N, U (m)),
+// i.e. the perturbation T = (Exp(dtheta) R, p + dp).
+using PoseCovariance = Eigen::Matrix<double, 6, 6>;
+
+struct SmoothedNodes {
+  std::vector<Eigen::Isometry3d> T_enu_b;  // at each fix, same order
+  // Marginal covariance of each node (ceres::Covariance, sparse QR); empty when the solve's
+  // Jacobian was too ill-conditioned to invert (then no covariance is reported, never a guess).
+  std::vector<PoseCovariance> covariance;
+};
+
+// The smoothed body pose T_enu_b at each fix. `lever_arm_b`: antenna in the body.
+SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Vector3d& lever_arm_b,
+                          const RelativeNoise& noise, double huber_sigmas,
+                          const SmootherConfig& config);
 
 // Every VIO pose in ENU: between nodes i and i+1 the two nodes carried by the VIO motion, blended
 // linearly in time (slerp for the rotation); before the first / after the last node, that node
 // carried by the VIO. `nodes` must be in time order with `smoothed` of the same size (>= 1).
+// With `covariance_out` and node covariances: each pose's covariance is the blend of its nodes'
+// plus the VIO drift (noise model) over the distance to the nearer node.
 Trajectory spreadOverVio(const Trajectory& vio, const std::vector<SmootherFix>& nodes,
-                         const std::vector<Eigen::Isometry3d>& smoothed);
+                         const SmoothedNodes& smoothed, const RelativeNoise& noise = {},
+                         std::vector<PoseCovariance>* covariance_out = nullptr);
 
 }  // namespace gvio::fusion

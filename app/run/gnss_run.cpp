@@ -3,6 +3,9 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <cmath>
+#include <utility>
+
 #include "io/atomic_write.hpp"
 #include "io/trajectory_io.hpp"
 #include "run/stats.hpp"
@@ -12,6 +15,37 @@ namespace {
 
 double seconds(std::int64_t t_ns) {
   return static_cast<double>(t_ns) * 1e-9;
+}
+
+// trajectory_cov.csv: per pose the E/N/U position sigmas, the heading sigma, and the full 6x6
+// covariance (upper triangle, row-major) in the order rotation about E, N, U (rad), position E,
+// N, U (m).
+void writeCovariance(const std::filesystem::path& file, const Trajectory& poses,
+                     const std::vector<fusion::PoseCovariance>& cov) {
+  io::writeFileAtomic(file, [&](std::ostream& os) {
+    os << "# t_s,sigma_e_m,sigma_n_m,sigma_u_m,sigma_yaw_deg, then the 6x6 covariance of "
+          "(rot_e, rot_n, rot_u [rad], e, n, u [m]), upper triangle row-major (21 values)\n";
+    for (std::size_t k = 0; k < cov.size() && k < poses.size(); ++k) {
+      const fusion::PoseCovariance& c = cov[k];
+      os << fmt::format("{:.9f},{:.4f},{:.4f},{:.4f},{:.4f}", seconds(poses.t_ns[k]),
+                        std::sqrt(c(3, 3)), std::sqrt(c(4, 4)), std::sqrt(c(5, 5)),
+                        std::sqrt(c(2, 2)) * 180.0 / M_PI);
+      for (int i = 0; i < 6; ++i) {
+        for (int j = i; j < 6; ++j) os << fmt::format(",{:.6e}", c(i, j));
+      }
+      os << "\n";
+    }
+  });
+}
+
+// Mean / p95 / max of each smoothed pose's 3-D position sigma; null without covariances.
+nlohmann::json positionSigma(const std::vector<fusion::PoseCovariance>& cov) {
+  if (cov.empty()) return nullptr;
+  std::vector<double> sigma;
+  sigma.reserve(cov.size());
+  for (const auto& c : cov) sigma.push_back(std::sqrt(c.bottomRightCorner<3, 3>().trace()));
+  const TimingSummary s = summarizeTimings(std::move(sigma));  // any samples, not only ms
+  return {{"mean", s.mean}, {"p95", s.p95}, {"max", s.max}};
 }
 
 }  // namespace
@@ -51,6 +85,7 @@ std::optional<GnssRunResult> fuseGnss(const io::Dataset& ds, const Trajectory& v
     r.fused = fusion.fusedTrajectory();
   } else {
     r.fused_online = fusion.fusedTrajectory();
+    r.fused_covariance = fusion.smoothedCovariance();
   }
   r.T_enu_w = fusion.T_enu_w();
   if (!r.T_enu_w) {
@@ -77,6 +112,9 @@ void writeGeoreferencedOutputs(const std::filesystem::path& out, const GnssRunRe
   if (r.fused.empty()) return;
   io::writeTum(out / "trajectory.tum", r.fused);
   if (!r.fused_online.empty()) io::writeTum(out / "trajectory_online.tum", r.fused_online);
+  if (!r.fused_covariance.empty()) {
+    writeCovariance(out / "trajectory_cov.csv", r.fused, r.fused_covariance);
+  }
   const fusion::EnuFrame enu(r.origin);
   io::writeFileAtomic(out / "trajectory_lla.csv", [&](std::ostream& os) {
     os << "# t_s,lat_deg,lon_deg,h_ellipsoid_m,qw,qx,qy,qz (body in local ENU)\n";
@@ -133,6 +171,7 @@ nlohmann::json gnssReport(const GnssRunResult& r, std::size_t fixes_in_dataset) 
           {"registered", r.T_enu_w.has_value()},
           {"smoothed", !r.fused_online.empty()},
           {"ms_smoothing", r.stats.ms_smoothing},
+          {"position_sigma_m", positionSigma(r.fused_covariance)},
           {"poses_before_registration", r.stats.poses_before_alignment},
           {"ms_per_fix", {{"mean", cost.mean}, {"p95", cost.p95}, {"max", cost.max}}},
           {"enu_origin",

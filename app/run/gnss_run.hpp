@@ -24,6 +24,7 @@ struct GnssRunResult {
   // smoothing pass ran (graph mode), else the causal one.
   Trajectory fused;
   Trajectory fused_online;  // the causal T_enu_b, only when `fused` is the smoothed one
+  std::vector<fusion::PoseCovariance> fused_covariance;  // per smoothed pose, may be empty
   std::optional<Eigen::Isometry3d> T_enu_w;
 };
 
@@ -39,7 +40,8 @@ void writeGnssFixes(const std::filesystem::path& file, const GnssRunResult& resu
 
 // gnss_fixes.csv, and when the fusion registered: trajectory.tum (T_enu_b), trajectory_lla.csv (t,
 // lat, lon, h, qw qx qy qz of the body in ENU), georef.json and, when trajectory.tum is the
-// smoothed one, trajectory_online.tum (causal), all atomically.
+// smoothed one, trajectory_online.tum (causal) and trajectory_cov.csv (each smoothed pose's
+// covariance), all atomically.
 void writeGeoreferencedOutputs(const std::filesystem::path& out, const GnssRunResult& result);
 
 // report.json's "gnss" object and "outages" array.

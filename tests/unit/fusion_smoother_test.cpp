@@ -18,6 +18,7 @@ namespace {
 struct Fused {
   Trajectory online, smoothed;
   FusionStats stats;
+  std::vector<PoseCovariance> covariance;
 };
 
 Fused fuse(const test::GnssDrive& d, const SmootherConfig& smoother) {
@@ -31,7 +32,8 @@ Fused fuse(const test::GnssDrive& d, const SmootherConfig& smoother) {
     fusion.addVioPose(d.vio.t_ns[k], d.vio.poses[k]);
   }
   fusion.finish();
-  return {fusion.fusedTrajectory(), fusion.smoothedTrajectory(), fusion.stats()};
+  return {fusion.fusedTrajectory(), fusion.smoothedTrajectory(), fusion.stats(),
+          fusion.smoothedCovariance()};
 }
 
 double rmse(const Trajectory& truth, const Trajectory& est) {
@@ -50,14 +52,14 @@ TEST(GnssSmoother, SpreadsExactNodesOverAnExactVioExactly) {
   T_w_enu.translation() = Eigen::Vector3d(5, -3, 1);
   Trajectory vio;
   std::vector<SmootherFix> nodes;
-  std::vector<Eigen::Isometry3d> smoothed;
+  SmoothedNodes smoothed;
   for (std::size_t k = 0; k < 400; ++k) {
     vio.t_ns.push_back(d.truth.t_ns[k]);
     vio.poses.push_back(T_w_enu * d.truth.poses[k]);
     if (k % 7 == 3) {
       nodes.push_back(
           {d.truth.t_ns[k], vio.poses.back(), d.truth.poses[k], Eigen::Vector3d::Zero(), 1.0, 1.0});
-      smoothed.push_back(d.truth.poses[k]);
+      smoothed.T_enu_b.push_back(d.truth.poses[k]);
     }
   }
   const Trajectory out = spreadOverVio(vio, nodes, smoothed);
@@ -88,6 +90,19 @@ TEST(GnssSmoother, BeatsTheCausalOutputOnBiasedFixes) {
   EXPECT_LT(smoothed, 0.75 * online);
   EXPECT_LT(smoothed, smoothed_no_bias);
   EXPECT_LT(smoothed, 1.3);
+
+  // The reported position covariance is consistent with the errors: the mean normalised squared
+  // error (NEES, 3 dof) is near 3, neither overconfident (>> 3) nor uselessly loose (<< 3).
+  ASSERT_EQ(a.covariance.size(), a.smoothed.size());
+  double nees = 0.0;
+  for (std::size_t k = 0; k < a.smoothed.size(); ++k) {
+    const Eigen::Vector3d e = a.smoothed.poses[k].translation() - d.truth.poses[k].translation();
+    nees += e.dot(a.covariance[k].bottomRightCorner<3, 3>().ldlt().solve(e));
+  }
+  nees /= static_cast<double>(a.smoothed.size());
+  std::printf("position NEES %.2f (3 dof)\n", nees);
+  EXPECT_GT(nees, 1.0);
+  EXPECT_LT(nees, 9.0);
 }
 
 TEST(GnssSmoother, IsOffInKfModeAndWhenDisabled) {
