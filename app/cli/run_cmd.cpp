@@ -134,10 +134,11 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
   }
   nlohmann::json map_report;
   if (recorder && !recorder->empty()) {
-    const run::MapRunResult map =
+    run::MapRunResult map =
         run::buildMap(*recorder, gnss && !gnss->fused.empty() ? &gnss->fused : nullptr);
-    run::writeMapFiles(out, map);
     map_report = run::mapReport(*recorder, map);
+    recorder.reset();  // the keyframe store is rebuilt into `map`: free it before writing
+    run::writeMapFiles(out, map);
     spdlog::info("map ({}): {} landmarks, {} dense points, {} occupied voxels", map.frame,
                  map.map.counts.sparse_points, map.map.counts.dense_points,
                  map.map.counts.occupied_leaves);

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cstring>
 
 #include "export/map_files.hpp"
 #include "fusion/vio_enu_alignment.hpp"
@@ -30,6 +31,35 @@ void writeTreeAtomic(const std::filesystem::path& file,
     throw io::InputError(file, 0, "cannot write the OctoMap file");
   }
   io::moveIntoPlace(tmp, file);
+}
+
+// The merged cloud (sparse landmarks first, then the dense points) as PCL's blob without a merged
+// copy in between: the dense cloud is released as soon as its bytes are in the blob, so the map
+// is held once. pcl::toPCLPointCloud2 copies the point structs byte for byte (point_step =
+// sizeof(MapPoint)), which is what is done here for the two clouds one after the other.
+pcl::PCLPointCloud2 mapBlob(const mapping::MapCloud& sparse, mapping::MapCloud& dense) {
+  pcl::PCLPointCloud2 blob;
+  pcl::toPCLPointCloud2(mapping::MapCloud{}, blob);
+  static_assert(sizeof(mapping::MapPoint) % 4 == 0);
+  if (blob.point_step != sizeof(mapping::MapPoint)) {  // not PCL's layout: the plain copy
+    pcl::toPCLPointCloud2(mapping::mergeMapClouds(sparse, dense), blob);
+    mapping::MapCloud().swap(dense);
+    return blob;
+  }
+  const std::size_t n = sparse.size() + dense.size();
+  blob.width = static_cast<std::uint32_t>(n);
+  blob.height = 1;
+  blob.row_step = blob.point_step * blob.width;
+  blob.is_dense = static_cast<std::uint8_t>(sparse.is_dense && dense.is_dense);
+  blob.data.resize(n * blob.point_step);
+  const std::size_t sparse_bytes = sparse.size() * sizeof(mapping::MapPoint);
+  if (!sparse.empty()) std::memcpy(blob.data.data(), sparse.data(), sparse_bytes);
+  if (!dense.empty()) {
+    std::memcpy(blob.data.data() + sparse_bytes, dense.data(),
+                dense.size() * sizeof(mapping::MapPoint));
+  }
+  mapping::MapCloud().swap(dense);
+  return blob;
 }
 
 }  // namespace
@@ -61,18 +91,19 @@ MapRunResult buildMap(const MapRecorder& recorder, const Trajectory* fused) {
   return r;
 }
 
-void writeMapFiles(const std::filesystem::path& out, const MapRunResult& r) {
-  const mapping::MapCloud cloud = mapping::mergeMapClouds(r.map.sparse, r.map.dense);
-  if (cloud.empty()) {
+void writeMapFiles(const std::filesystem::path& out, MapRunResult& r) {
+  // Largest first out of memory: the trees are written and freed before the cloud is converted.
+  if (r.map.occupancy) writeTreeAtomic(out / "map.bt", *r.map.occupancy, true);
+  r.map.occupancy.reset();
+  if (r.map.occupancy_color) writeTreeAtomic(out / "map.ot", *r.map.occupancy_color, false);
+  r.map.occupancy_color.reset();
+  if (r.map.sparse.empty() && r.map.dense.empty()) {
     spdlog::warn("the map is empty (no keyframe had landmarks or depth): no map files written");
     return;
   }
-  pcl::PCLPointCloud2 blob;
-  pcl::toPCLPointCloud2(cloud, blob);
+  const pcl::PCLPointCloud2 blob = mapBlob(r.map.sparse, r.map.dense);
   exporter::writePcd(out / "map.pcd", blob);
   exporter::writePly(out / "map.ply", blob);
-  if (r.map.occupancy) writeTreeAtomic(out / "map.bt", *r.map.occupancy, true);
-  if (r.map.occupancy_color) writeTreeAtomic(out / "map.ot", *r.map.occupancy_color, false);
 }
 
 nlohmann::json mapReport(const MapRecorder& recorder, const MapRunResult& r) {

@@ -46,8 +46,9 @@ struct MapRunResult {
 MapRunResult buildMap(const MapRecorder& recorder, const Trajectory* fused);
 
 // map.pcd (binary compressed), map.ply (binary), map.bt, map.ot, each atomically. An empty map
-// writes nothing and warns.
-void writeMapFiles(const std::filesystem::path& out, const MapRunResult& result);
+// writes nothing and warns. Consumes the result's trees and dense cloud (each is freed once
+// written, so a long drive's map is not held twice); the counts stay.
+void writeMapFiles(const std::filesystem::path& out, MapRunResult& result);
 
 // report.json's "map": frame, counts, per-keyframe cost of each stage (ms mean/p95/max), memory.
 nlohmann::json mapReport(const MapRecorder& recorder, const MapRunResult& result);
