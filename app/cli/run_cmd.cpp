@@ -138,6 +138,7 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
         run::buildMap(*recorder, gnss && !gnss->fused.empty() ? &gnss->fused : nullptr);
     run::writeMapFiles(out, map);
     map_report = run::mapReport(*recorder, map);
+    map_report["las"] = run::writeMapLas(out, map);
     spdlog::info("map ({}): {} landmarks, {} dense points, {} occupied voxels", map.frame,
                  map.map.counts.sparse_points, map.map.counts.dense_points,
                  map.map.counts.occupied_leaves);

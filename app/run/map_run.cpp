@@ -1,10 +1,12 @@
 #include "run/map_run.hpp"
 
+#include <fmt/format.h>
 #include <pcl/conversions.h>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
 
+#include "export/georef.hpp"
 #include "export/map_files.hpp"
 #include "fusion/vio_enu_alignment.hpp"
 #include "io/atomic_write.hpp"
@@ -30,6 +32,14 @@ void writeTreeAtomic(const std::filesystem::path& file,
     throw io::InputError(file, 0, "cannot write the OctoMap file");
   }
   io::moveIntoPlace(tmp, file);
+}
+
+// The file map (sparse then dense points) as PCL's generic cloud; no data for an empty map.
+pcl::PCLPointCloud2 mapBlob(const MapRunResult& r) {
+  const mapping::MapCloud cloud = mapping::mergeMapClouds(r.map.sparse, r.map.dense);
+  pcl::PCLPointCloud2 blob;
+  if (!cloud.empty()) pcl::toPCLPointCloud2(cloud, blob);
+  return blob;
 }
 
 }  // namespace
@@ -62,17 +72,40 @@ MapRunResult buildMap(const MapRecorder& recorder, const Trajectory* fused) {
 }
 
 void writeMapFiles(const std::filesystem::path& out, const MapRunResult& r) {
-  const mapping::MapCloud cloud = mapping::mergeMapClouds(r.map.sparse, r.map.dense);
-  if (cloud.empty()) {
+  const pcl::PCLPointCloud2 blob = mapBlob(r);
+  if (blob.data.empty()) {
     spdlog::warn("the map is empty (no keyframe had landmarks or depth): no map files written");
     return;
   }
-  pcl::PCLPointCloud2 blob;
-  pcl::toPCLPointCloud2(cloud, blob);
   exporter::writePcd(out / "map.pcd", blob);
   exporter::writePly(out / "map.ply", blob);
   if (r.map.occupancy) writeTreeAtomic(out / "map.bt", *r.map.occupancy, true);
   if (r.map.occupancy_color) writeTreeAtomic(out / "map.ot", *r.map.occupancy_color, false);
+}
+
+nlohmann::json writeMapLas(const std::filesystem::path& out, const MapRunResult& r) {
+  const std::filesystem::path file = out / "map.las";
+  const pcl::PCLPointCloud2 blob = r.frame == "enu" ? mapBlob(r) : pcl::PCLPointCloud2();
+  if (blob.data.empty()) {
+    const std::string reason =
+        r.frame == "enu"
+            ? "the map is empty"
+            : "the run is not georeferenced (no GNSS fusion, or the VIO world was never "
+              "registered to ENU: no georef.json), so the map is in the VIO world frame";
+    spdlog::info("no map.las: {}", reason);
+    std::error_code ec;
+    if (std::filesystem::remove(file, ec)) {
+      spdlog::info("removed {} of an earlier run", file.string());
+    }
+    return {{"written", false}, {"reason", reason}};
+  }
+  const exporter::Georef georef = exporter::readGeoref(out / "georef.json");
+  const exporter::LasSummary s = exporter::writeMapLas(file, blob, georef, out / "map.pcd");
+  return {{"written", true},
+          {"file", "map.las"},
+          {"points", s.points},
+          {"crs", fmt::format("EPSG:{} (UTM zone {}{}) + ellipsoidal height", s.crs.epsg(),
+                              s.crs.zone, s.crs.north ? "N" : "S")}};
 }
 
 nlohmann::json mapReport(const MapRecorder& recorder, const MapRunResult& r) {

@@ -2,7 +2,8 @@
 // gvio run's map stage: keyframes go into a mapping::MapBuilder while the VIO runs (their dense
 // stereo points and landmarks in their own frames); after GNSS fusion the map is built from the
 // final poses (T_enu_b when fused, else the VIO poses) and written as map.pcd, map.ply (the merged
-// sparse + dense cloud, float32) and map.bt / map.ot (OctoMap OcTree / ColorOcTree).
+// sparse + dense cloud, float32), map.bt / map.ot (OctoMap OcTree / ColorOcTree) and, when the run
+// is georeferenced, map.las (the same cloud in UTM, as `gvio export --to las` writes it).
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -48,6 +49,13 @@ MapRunResult buildMap(const MapRecorder& recorder, const Trajectory* fused);
 // map.pcd (binary compressed), map.ply (binary), map.bt, map.ot, each atomically. An empty map
 // writes nothing and warns.
 void writeMapFiles(const std::filesystem::path& out, const MapRunResult& result);
+
+// map.las (LAS 1.4 in UTM + ellipsoidal height) through the run's georef.json with
+// exporter::writeMapLas, the function behind `gvio export --to las`, when the map is in ENU (the
+// run is georeferenced: georef.json written). Otherwise none, with the reason logged; a map.las
+// of an earlier run in `out` is removed. Returns report.json's map "las": written, and the file,
+// points and CRS, or the reason.
+nlohmann::json writeMapLas(const std::filesystem::path& out, const MapRunResult& result);
 
 // report.json's "map": frame, counts, per-keyframe cost of each stage (ms mean/p95/max), memory.
 nlohmann::json mapReport(const MapRecorder& recorder, const MapRunResult& result);
