@@ -56,16 +56,16 @@ void MapRecorder::addKeyframe(const KeyframeInput& kf) {
       builder_->addKeyframe(kf.t_ns, kf.T_w_b, kf.left, kf.right, kf.estimator.landmarks()));
 }
 
+mapping::PoseLookup mapPoses(const MapRecorder& recorder, const Trajectory* fused) {
+  if (fused == nullptr || fused->empty()) return recorder.builder().vioPoses();
+  return [fused](std::int64_t t_ns) { return fusion::interpolatePose(*fused, t_ns); };
+}
+
 MapRunResult buildMap(const MapRecorder& recorder, const Trajectory* fused) {
   const auto start = std::chrono::steady_clock::now();
   MapRunResult r;
-  const bool enu = fused != nullptr && !fused->empty();
-  r.frame = enu ? "enu" : "vio_world";
-  const mapping::PoseLookup pose_of = enu ? mapping::PoseLookup([fused](std::int64_t t_ns) {
-    return fusion::interpolatePose(*fused, t_ns);
-  })
-                                          : recorder.builder().vioPoses();
-  r.map = recorder.builder().build(pose_of);
+  r.frame = fused != nullptr && !fused->empty() ? "enu" : "vio_world";
+  r.map = recorder.builder().build(mapPoses(recorder, fused));
   r.build_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return r;

@@ -42,6 +42,11 @@ struct MapRunResult {
   double build_ms = 0.0;
 };
 
+// The poses the map is built with: the fused trajectory's (T_enu_b, interpolated at the keyframe
+// stamps) when `fused` is given and not empty, else the keyframes' VIO poses (T_w_b). Refers to
+// `recorder` and `fused`: use it while they live.
+mapping::PoseLookup mapPoses(const MapRecorder& recorder, const Trajectory* fused);
+
 // Builds the map with the fused trajectory's poses (interpolated at the keyframe stamps) when
 // `fused` is given and not empty, else with the keyframes' VIO poses.
 MapRunResult buildMap(const MapRecorder& recorder, const Trajectory* fused);
