@@ -56,8 +56,13 @@ case "$mode" in
     # directly comparable with its truth (report.json evaluation_fused).
     "$BUILD_DIR/app/gvio" run --dataset out/demo/drive --gnss graph --out out/demo/run \
       --set fusion.origin=48.98253,8.39035,116.4 --set "fusion.lever_arm_b=[0,0,0.8]"
-    "$BUILD_DIR/app/gvio" render --run out/demo/run --view error --out out/demo/run/render/error.png
-    echo "setup: demo drive in out/demo/drive, VIO run (trajectory_vio.tum, report.json) in out/demo/run"
+    # The views shown in README.md (docs/images/ holds copies): trajectory error, and the map from
+    # above, in perspective and as OctoMap voxels.
+    for view in error topdown perspective octomap; do
+      "$BUILD_DIR/app/gvio" render --run out/demo/run --view "$view" --out "out/demo/run/render/$view.png"
+    done
+    echo "setup: demo drive in out/demo/drive, run (trajectories, map.pcd/ply/las/bt/ot, report.json)" \
+      "in out/demo/run, images in out/demo/run/render"
     ;;
   *)
     echo "usage: ./setup.sh [demo|test|build]" >&2

@@ -14,6 +14,10 @@
 #include "render/render_error.hpp"
 
 namespace gvio::render {
+double annotationUnitPx(int width, int height) {
+  return std::max(std::min(width, height) / 60.0, 7.0);
+}
+
 namespace {
 
 constexpr Rgb kInk{0.1F, 0.1F, 0.1F};
@@ -28,7 +32,7 @@ struct Style {
 };
 
 Style styleFor(int width, int height) {
-  const double base = std::max(std::min(width, height) / 60.0, 7.0);
+  const double base = annotationUnitPx(width, height);
   return {base, base, 0.6 * base, 1.4 * base, 1.9 * base, std::max(1.0, 0.1 * base)};
 }
 

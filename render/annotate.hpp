@@ -33,6 +33,11 @@ struct Annotations {
   std::optional<double> north_deg;
 };
 
+// The unit every overlay length is a multiple of (1/60 of the image's shorter side, at least
+// 7 px): the compass and colour bar column at the right edge stays within 10 units of it, the
+// title strip at the top within 5 (so views can keep their content clear of them).
+double annotationUnitPx(int width, int height);
+
 // Draws `a` onto `image` in place; pixels no overlay touches keep their exact bytes. Throws
 // RenderError on an empty or inconsistent image, or on a non-finite colour bar range, scale or
 // north direction.

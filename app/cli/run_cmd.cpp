@@ -13,6 +13,7 @@
 #include "odometry/error.hpp"
 #include "run/evaluation.hpp"
 #include "run/gnss_run.hpp"
+#include "run/map_passes.hpp"
 #include "run/map_run.hpp"
 #include "run/report.hpp"
 #include "run/stats.hpp"
@@ -29,6 +30,7 @@ struct RunOptions {
   std::string gnss_noise = "none";
   std::uint64_t seed = 1;
   std::string out = "out/run";
+  std::optional<std::string> two_pass;
   ConfigOptions config;
 };
 
@@ -79,6 +81,8 @@ nlohmann::json degradeGnss(io::Dataset& ds, const std::string& spec, std::uint64
 
 int runRun(const RunOptions& opt, const CommonOptions& common) {
   checkGnssOption(opt.gnss);
+  const std::optional<run::TwoPassSpans> two_pass =
+      opt.two_pass ? std::optional(run::parseTwoPass(*opt.two_pass)) : std::nullopt;
   const AppConfig config = opt.config.load();
   io::Dataset ds = io::readDataset(opt.dataset, io::parseDatasetFormat(opt.format), config.dataset);
   for (const auto& w : ds.warnings) spdlog::warn("{}", w);
@@ -134,14 +138,20 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
   }
   nlohmann::json map_report;
   if (recorder && !recorder->empty()) {
-    run::MapRunResult map =
-        run::buildMap(*recorder, gnss && !gnss->fused.empty() ? &gnss->fused : nullptr);
+    const Trajectory* fused = gnss && !gnss->fused.empty() ? &gnss->fused : nullptr;
+    run::MapRunResult map = run::buildMap(*recorder, fused);
     map_report = run::mapReport(*recorder, map);
+    if (two_pass) {
+      map_report["two_pass"] = run::twoPassReport(*recorder, run::mapPoses(*recorder, fused),
+                                                  *two_pass, ds.frames.front().t_ns);
+    }
     recorder.reset();  // the keyframe store is rebuilt into `map`: free it before writing
-    run::writeMapFiles(out, map);
+    map_report["las"] = run::writeMapFiles(out, map);
     spdlog::info("map ({}): {} landmarks, {} dense points, {} occupied voxels", map.frame,
                  map.map.counts.sparse_points, map.map.counts.dense_points,
                  map.map.counts.occupied_leaves);
+  } else if (two_pass) {
+    spdlog::warn("--two-pass: the run has no map (map.enabled false, or no keyframe)");
   }
   run::ReportContext context;
   context.map = map_report;
@@ -216,6 +226,9 @@ Command addRunCommand(CLI::App& app, const CommonOptions& common) {
   sub->add_option("--seed", opt->seed, "Random seed of --gnss-noise")->capture_default_str();
   sub->add_option("--out", opt->out, "Run folder (created if missing; files in it are replaced)")
       ->capture_default_str();
+  sub->add_option("--two-pass", opt->two_pass,
+                  "T0:T1,T2:T3: two passes over the same place (seconds since the first frame); "
+                  "report.json map.two_pass says how well their map points agree");
   opt->config.addTo(*sub);
   return {sub, [opt, &common] { return runRun(*opt, common); }};
 }

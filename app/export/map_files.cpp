@@ -222,6 +222,16 @@ std::vector<LasPoint> lasPoints(const pcl::PCLPointCloud2& cloud) {
   return points;
 }
 
+LasSummary writeMapLas(const fs::path& file, const pcl::PCLPointCloud2& cloud, const Georef& georef,
+                       const fs::path& source) {
+  const std::vector<LasPoint> points = lasPoints(cloud);
+  if (points.empty()) throw io::InputError(source, 0, "map is empty (0 finite points)");
+  LasOptions options;
+  options.utm_zone = georef.utm_zone;
+  options.utm_north = georef.utm_north;
+  return writeLas(file, georef.enu_origin, points, options);
+}
+
 OctreeSummary copyOctreeBinary(const fs::path& in, const fs::path& out) {
   checkReadable(in);
   (void)io::readOccupancy(in);  // header and node stream checked before OctoMap recurses into it

@@ -9,6 +9,7 @@
 
 #include <pcl/PCLPointCloud2.h>
 
+#include "export/georef.hpp"
 #include "export/las_writer.hpp"
 
 namespace gvio::exporter {
@@ -25,6 +26,12 @@ void writePly(const std::filesystem::path& file, const pcl::PCLPointCloud2& clou
 // range by the field's type: 8-bit x 257, 16-bit as is, floats in [0, 1] x 65535, floats up to
 // 255 x 257, anything else clamped.
 std::vector<LasPoint> lasPoints(const pcl::PCLPointCloud2& cloud);
+
+// A map cloud (local ENU at georef's origin) as LAS 1.4 in georef's UTM zone, atomically: what
+// `gvio export --to las` and gvio run's map.las write. Throws InputError naming `source` (the
+// cloud's file, or the run's map.pcd) when the cloud has no finite point.
+LasSummary writeMapLas(const std::filesystem::path& file, const pcl::PCLPointCloud2& cloud,
+                       const Georef& georef, const std::filesystem::path& source);
 
 struct OctreeSummary {
   std::string type;  // "OcTree", "ColorOcTree", ...

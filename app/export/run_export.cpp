@@ -120,12 +120,7 @@ ExportResult exportCloud(const fs::path& run, ExportFormat format, const fs::pat
   r.what = "points";
   if (format == ExportFormat::kLas) {
     const Georef georef = readGeoref(requireFile(run / "georef.json", kMadeByGnss));
-    const std::vector<LasPoint> points = lasPoints(cloud);
-    if (points.empty()) throw io::InputError(r.source, 0, "map is empty (0 finite points)");
-    LasOptions options;
-    options.utm_zone = georef.utm_zone;
-    options.utm_north = georef.utm_north;
-    r.count = writeLas(out, georef.enu_origin, points, options).points;
+    r.count = writeMapLas(out, cloud, georef, r.source).points;
   } else {
     if (format == ExportFormat::kPcd) writePcd(out, cloud);
     if (format == ExportFormat::kPly) writePly(out, cloud);

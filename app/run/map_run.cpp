@@ -1,11 +1,13 @@
 #include "run/map_run.hpp"
 
+#include <fmt/format.h>
 #include <pcl/conversions.h>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
 #include <cstring>
 
+#include "export/georef.hpp"
 #include "export/map_files.hpp"
 #include "fusion/vio_enu_alignment.hpp"
 #include "io/atomic_write.hpp"
@@ -76,22 +78,51 @@ void MapRecorder::addKeyframe(const KeyframeInput& kf) {
       builder_->addKeyframe(kf.t_ns, kf.T_w_b, kf.left, kf.right, kf.estimator.landmarks()));
 }
 
+mapping::PoseLookup mapPoses(const MapRecorder& recorder, const Trajectory* fused) {
+  if (fused == nullptr || fused->empty()) return recorder.builder().vioPoses();
+  return [fused](std::int64_t t_ns) { return fusion::interpolatePose(*fused, t_ns); };
+}
+
 MapRunResult buildMap(const MapRecorder& recorder, const Trajectory* fused) {
   const auto start = std::chrono::steady_clock::now();
   MapRunResult r;
-  const bool enu = fused != nullptr && !fused->empty();
-  r.frame = enu ? "enu" : "vio_world";
-  const mapping::PoseLookup pose_of = enu ? mapping::PoseLookup([fused](std::int64_t t_ns) {
-    return fusion::interpolatePose(*fused, t_ns);
-  })
-                                          : recorder.builder().vioPoses();
-  r.map = recorder.builder().build(pose_of);
+  r.frame = fused != nullptr && !fused->empty() ? "enu" : "vio_world";
+  r.map = recorder.builder().build(mapPoses(recorder, fused));
   r.build_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return r;
 }
 
-void writeMapFiles(const std::filesystem::path& out, MapRunResult& r) {
+namespace {
+
+// map.las from the map's blob when the run is georeferenced, else the reason (and no stale file).
+nlohmann::json writeLasOrSayWhy(const std::filesystem::path& out, const std::string& frame,
+                                const pcl::PCLPointCloud2* blob) {
+  const std::filesystem::path file = out / "map.las";
+  if (frame != "enu" || blob == nullptr) {
+    const std::string reason =
+        frame == "enu" ? "the map is empty"
+                       : "the run is not georeferenced (no GNSS fusion, or the VIO world was never "
+                         "registered to ENU: no georef.json), so the map is in the VIO world frame";
+    spdlog::info("no map.las: {}", reason);
+    std::error_code ec;
+    if (std::filesystem::remove(file, ec)) {
+      spdlog::info("removed {} of an earlier run", file.string());
+    }
+    return {{"written", false}, {"reason", reason}};
+  }
+  const exporter::Georef georef = exporter::readGeoref(out / "georef.json");
+  const exporter::LasSummary s = exporter::writeMapLas(file, *blob, georef, out / "map.pcd");
+  return {{"written", true},
+          {"file", "map.las"},
+          {"points", s.points},
+          {"crs", fmt::format("EPSG:{} (UTM zone {}{}) + ellipsoidal height", s.crs.epsg(),
+                              s.crs.zone, s.crs.north ? "N" : "S")}};
+}
+
+}  // namespace
+
+nlohmann::json writeMapFiles(const std::filesystem::path& out, MapRunResult& r) {
   // Largest first out of memory: the trees are written and freed before the cloud is converted.
   if (r.map.occupancy) writeTreeAtomic(out / "map.bt", *r.map.occupancy, true);
   r.map.occupancy.reset();
@@ -99,11 +130,12 @@ void writeMapFiles(const std::filesystem::path& out, MapRunResult& r) {
   r.map.occupancy_color.reset();
   if (r.map.sparse.empty() && r.map.dense.empty()) {
     spdlog::warn("the map is empty (no keyframe had landmarks or depth): no map files written");
-    return;
+    return writeLasOrSayWhy(out, r.frame, nullptr);
   }
   const pcl::PCLPointCloud2 blob = mapBlob(r.map.sparse, r.map.dense);
   exporter::writePcd(out / "map.pcd", blob);
   exporter::writePly(out / "map.ply", blob);
+  return writeLasOrSayWhy(out, r.frame, &blob);
 }
 
 nlohmann::json mapReport(const MapRecorder& recorder, const MapRunResult& r) {

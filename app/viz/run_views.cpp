@@ -128,6 +128,21 @@ void heightBar(double lo, double hi, ViewSpec& v) {
       render::Annotations::ColorBar{render::ColorMap::kViridis, lo, hi, "height (m)"};
 }
 
+// A top-down camera fitted to `box` with the box kept clear of the overlays: the compass and
+// colour bar column at the right edge and the title strip at the top (render::annotationUnitPx).
+// The reserve is in pixels, so it is refitted until the scale settles.
+render::RenderCamera topDownClearOfOverlays(const Eigen::AlignedBox3d& box, int width, int height) {
+  const double unit = render::annotationUnitPx(width, height);
+  render::RenderCamera camera = render::topDownCamera(box, width, height, 0.08);
+  for (int i = 0; i < 4; ++i) {
+    Eigen::AlignedBox3d reserved = box;
+    reserved.max().x() += 10.0 * unit * camera.metres_per_pixel;
+    reserved.max().y() += 5.0 * unit * camera.metres_per_pixel;
+    camera = render::topDownCamera(reserved, width, height, 0.08);
+  }
+  return camera;
+}
+
 // Orthographic, north up. Layers by height, since the camera looks straight down: the cloud at
 // its own heights, then (lifted above everything) used fixes, trajectories, outages, rejected and
 // skipped fixes, start/end.
@@ -167,7 +182,7 @@ void buildTopDown(const io::RunFiles& run, int width, int height, ViewSpec& v) {
   v.annotations.legend.insert(v.annotations.legend.end(), fix_legend.begin(), fix_legend.end());
   Eigen::AlignedBox3d box = fit;
   box.extend(Eigen::Vector3d(fit.min().x(), fit.min().y(), top + 6.0));
-  v.camera = render::topDownCamera(box, width, height, 0.08);
+  v.camera = topDownClearOfOverlays(box, width, height);
   v.annotations.metres_per_pixel = v.camera.metres_per_pixel;
   v.annotations.north_deg = 0.0;  // ENU top-down: north is up
   v.scene.grids.push_back(groundGrid(fit, kGridBelowM));
@@ -305,7 +320,7 @@ ViewSpec buildRunView(const io::RunFiles& run, RunView view, int width, int heig
       addErrorColouredTrajectory(run, v);
       const Eigen::AlignedBox3d box = v.scene.bounds();
       v.scene.grids.push_back(groundGrid(box));
-      v.camera = render::topDownCamera(box, width, height, 0.08);
+      v.camera = topDownClearOfOverlays(box, width, height);
       v.annotations.metres_per_pixel = v.camera.metres_per_pixel;
       v.annotations.north_deg = 0.0;
       break;

@@ -10,6 +10,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "odometry/error.hpp"
+#include "render/annotate.hpp"
+#include "render/camera.hpp"
 #include "render/renderer.hpp"
 #include "render_map_fixture.hpp"
 #include "support/render_fixture.hpp"
@@ -121,6 +123,32 @@ TEST_F(RenderMapViews, TopDownWithoutMapIsTheTrajectoryView) {
   const render::ImageRgba img = draw(v);
   EXPECT_THAT(colourAt(img, v.camera, {10, 0, 0}), ColourNear(legendColour(v, "fused"), 0.03));
   EXPECT_TRUE(isBackground(colourAt(img, v.camera, {11, -1, 0})));  // no ground any more
+}
+
+// The drawing stays clear of the overlays: no pose under the compass / colour bar column (the
+// right 10 annotation units) or the title strip (the top 5), for a drive wider than the image's
+// aspect and for one taller.
+TEST_F(RenderMapViews, TopDownKeepsTheDrawingClearOfTheOverlays) {
+  const double unit = render::annotationUnitPx(kW, kH);
+  for (const Eigen::Vector3d& step : {Eigen::Vector3d(3, 0.2, 0), Eigen::Vector3d(0.2, 3, 0)}) {
+    io::RunFiles r = run();
+    r.cloud.reset();
+    r.fused = Trajectory();
+    for (int k = 0; k <= 100; ++k) {
+      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+      T.translation() = k * step;
+      r.fused->t_ns.push_back(k * 100'000'000LL);
+      r.fused->poses.push_back(T);
+    }
+    const viz::ViewSpec v = viz::buildRunView(r, RunView::kTopDown, kW, kH);
+    for (const Eigen::Isometry3d& T : r.fused->poses) {
+      const Eigen::Vector2d px = render::projectToPixel(v.camera, T.translation());
+      EXPECT_GE(px.x(), 0.0);
+      EXPECT_LE(px.x(), kW - 10.0 * unit) << T.translation().transpose();
+      EXPECT_GE(px.y(), 5.0 * unit) << T.translation().transpose();
+      EXPECT_LE(px.y(), kH);
+    }
+  }
 }
 
 TEST_F(RenderMapViews, PerspectiveSeesTheWallAheadFromBehindAndAbove) {
