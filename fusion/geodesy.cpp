@@ -43,6 +43,10 @@ Eigen::Vector3d EnuFrame::toEnu(const Lla& lla) const {
   return R_enu_ecef_ * (llaToEcef(lla) - origin_ecef_);
 }
 
+Eigen::Vector3d EnuFrame::ecefToEnu(const Eigen::Vector3d& p_ecef) const {
+  return R_enu_ecef_ * (p_ecef - origin_ecef_);
+}
+
 Lla EnuFrame::toLla(const Eigen::Vector3d& p_enu) const {
   return ecefToLla(origin_ecef_ + R_enu_ecef_.transpose() * p_enu);
 }

@@ -22,6 +22,9 @@ class EnuFrame {
   [[nodiscard]] const Lla& origin() const { return origin_; }
   [[nodiscard]] Eigen::Vector3d toEnu(const Lla& lla) const;
   [[nodiscard]] Lla toLla(const Eigen::Vector3d& p_enu) const;
+  // ECEF position -> ENU, and the rotation of ECEF vectors into ENU (rows: east, north, up).
+  [[nodiscard]] Eigen::Vector3d ecefToEnu(const Eigen::Vector3d& p_ecef) const;
+  [[nodiscard]] const Eigen::Matrix3d& R_enu_ecef() const { return R_enu_ecef_; }
 
  private:
   Lla origin_;

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,10 @@ struct GnssFix {
   int quality = 1;         // NMEA GGA fix quality (1 SPP, 2 DGPS, 4 RTK fixed, 5 RTK float)
   double hdop = 0.0;       // 0 when the source does not report it
   int num_sats = 0;        // 0 when the source does not report it
+  // Velocity over ground as the receiver reports it (speed and course, the course clockwise from
+  // true north); NaN when the source does not report it.
+  double speed_mps = std::numeric_limits<double>::quiet_NaN();
+  double course_deg = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Pinhole camera with radial-tangential (OpenCV plumb_bob) distortion and its pose in the body.

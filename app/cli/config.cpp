@@ -167,9 +167,21 @@ std::optional<fusion::Lla> FusionAppConfig::originLla() const {
   return lla;
 }
 
+fusion::InsConfig FusionAppConfig::insConfig(const ImuNoise& imu_noise) const {
+  fusion::InsConfig c = ins;
+  c.lever_arm_b = fusion.lever_arm_b;
+  c.receiver_time_offset_s = fusion.receiver_time_offset_s;
+  c.gate_chi2 = fusion.gate_chi2;
+  c.max_consecutive_rejections = fusion.max_consecutive_rejections;
+  c.outage_s = fusion.outage_s;
+  c.imu = imu_noise;
+  return c;
+}
+
 void FusionAppConfig::validate() const {
   (void)originLla();
   fusion.validate();
+  insConfig(ImuNoise{}).validate();
 }
 
 void VioConfig::validate() const {
@@ -210,6 +222,8 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("dataset.nmea_uere_rtk_float_m", c.dataset.nmea_uere_rtk_float_m),
       number("dataset.nmea_uere_rtk_fixed_m", c.dataset.nmea_uere_rtk_fixed_m),
       number("dataset.nmea_vertical_factor", c.dataset.nmea_vertical_factor),
+      number("dataset.comma2k19_sigma_h_m", c.dataset.comma2k19_sigma_h_m),
+      number("dataset.comma2k19_sigma_v_m", c.dataset.comma2k19_sigma_v_m),
       boolean("imu.prefer_dataset_noise", c.imu.prefer_dataset_noise),
       number("imu.acc_noise_density", c.imu.noise.acc_noise_density),
       number("imu.gyr_noise_density", c.imu.noise.gyr_noise_density),
@@ -270,6 +284,21 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("fusion.kf.q_velocity", c.fusion.fusion.kf.q_velocity),
       number("fusion.kf.initial_position_sigma_m", c.fusion.fusion.kf.initial_position_sigma_m),
       number("fusion.kf.initial_velocity_sigma_mps", c.fusion.fusion.kf.initial_velocity_sigma_mps),
+      boolean("fusion.ins.estimate_time_offset", c.fusion.ins.estimate_time_offset),
+      number("fusion.ins.time_offset_sigma_s", c.fusion.ins.time_offset_sigma_s),
+      number("fusion.ins.time_offset_random_walk", c.fusion.ins.time_offset_random_walk),
+      boolean("fusion.ins.use_velocity", c.fusion.ins.use_velocity),
+      number("fusion.ins.velocity_sigma_mps", c.fusion.ins.velocity_sigma_mps),
+      number("fusion.ins.velocity_min_speed_mps", c.fusion.ins.velocity_min_speed_mps),
+      number("fusion.ins.velocity_gate_chi2", c.fusion.ins.velocity_gate_chi2),
+      number("fusion.ins.init_window_s", c.fusion.ins.init_window_s),
+      number("fusion.ins.init_min_speed_mps", c.fusion.ins.init_min_speed_mps),
+      number("fusion.ins.init_tilt_sigma_deg", c.fusion.ins.init_tilt_sigma_deg),
+      number("fusion.ins.init_heading_sigma_deg", c.fusion.ins.init_heading_sigma_deg),
+      number("fusion.ins.init_velocity_sigma_mps", c.fusion.ins.init_velocity_sigma_mps),
+      number("fusion.ins.init_acc_bias_sigma_mps2", c.fusion.ins.init_acc_bias_sigma_mps2),
+      number("fusion.ins.init_gyr_bias_sigma_radps", c.fusion.ins.init_gyr_bias_sigma_radps),
+      number("fusion.ins.max_imu_gap_s", c.fusion.ins.max_imu_gap_s),
       number("sim.origin_lat_deg", c.sim.origin_lat_deg),
       number("sim.origin_lon_deg", c.sim.origin_lon_deg),
       number("sim.origin_h_m", c.sim.origin_h_m),

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fusion/gnss_fusion.hpp"
+#include "fusion/gnss_ins.hpp"
 #include "io/reader_config.hpp"
 #include "mapping/map_config.hpp"
 #include "odometry/measurements.hpp"
@@ -39,7 +40,12 @@ struct FusionAppConfig {
   // Origin of the local ENU frame: "first-fix", or "lat,lon,h" (deg, deg, ellipsoidal m).
   std::string origin = "first-fix";
   fusion::FusionConfig fusion;
+  // GNSS/INS without a camera (fusion.ins.*); its lever arm, time offset, gate, rejections and
+  // outage length are fusion.*'s, and its IMU noise imu.*'s: see insConfig().
+  fusion::InsConfig ins;
 
+  // `ins` with the shared fusion.* values and `imu_noise` filled in.
+  [[nodiscard]] fusion::InsConfig insConfig(const ImuNoise& imu_noise) const;
   // The origin as given, nullopt for first-fix; throws InvalidInput for malformed text.
   [[nodiscard]] std::optional<fusion::Lla> originLla() const;
   void validate() const;  // throws InvalidInput naming the key

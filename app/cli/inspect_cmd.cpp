@@ -60,10 +60,11 @@ int runInspect(const InspectOptions& opt, const CommonOptions& common) {
 Command addInspectCommand(CLI::App& app, const CommonOptions& common) {
   auto opt = std::make_shared<InspectOptions>();
   CLI::App* sub = app.add_subcommand("inspect", "Validate a dataset and summarise its sensors");
-  sub->add_option("--dataset", opt->dataset, "Dataset folder (KITTI raw drive, EuRoC) or NMEA log")
+  sub->add_option("--dataset", opt->dataset,
+                  "Dataset folder (KITTI raw drive, EuRoC, comma2k19) or NMEA log")
       ->required();
   sub->add_option("--format", opt->format, "Dataset format")
-      ->check(CLI::IsMember({"auto", "kitti-raw", "euroc", "nmea"}));
+      ->check(CLI::IsMember({"auto", "kitti-raw", "euroc", "nmea", "comma2k19"}));
   sub->add_option("--json", opt->json, "Also write the summary as JSON to this file");
   sub->add_flag("--quick", opt->quick,
                 "Decode only the first frame's images (text files are always fully checked)");

@@ -13,6 +13,7 @@
 #include "odometry/error.hpp"
 #include "run/evaluation.hpp"
 #include "run/gnss_run.hpp"
+#include "run/ins_run.hpp"
 #include "run/map_passes.hpp"
 #include "run/map_run.hpp"
 #include "run/report.hpp"
@@ -79,6 +80,51 @@ nlohmann::json degradeGnss(io::Dataset& ds, const std::string& spec, std::uint64
           {"added_error_rms_m", rms_m}};
 }
 
+// No camera frames but an IMU and GNSS: GNSS/INS on the IMU (run/ins_run.hpp) instead of VIO.
+int runGnssInsMode(const RunOptions& opt, const CommonOptions& common, const AppConfig& config,
+                   const io::Dataset& ds, const nlohmann::json& gnss_noise) {
+  const bool dataset_noise = ds.imu_noise && config.imu.prefer_dataset_noise;
+  const fusion::InsConfig ins =
+      config.fusion.insConfig(dataset_noise ? *ds.imu_noise : config.imu.noise);
+  const fs::path out = opt.out;
+  makeOutputDir(out);
+  spdlog::info("{} {} ({}): no camera frames, {} IMU samples, {} fixes: GNSS/INS",
+               io::toString(ds.format), ds.root.string(), ds.variant, ds.imu.size(),
+               ds.gnss.size());
+  const run::InsRunResult r = run::runGnssIns(ds, ins, config.fusion.originLla());
+  run::writeGnssInsOutputs(out, r);
+  std::optional<run::InsEvaluation> evaluation;
+  if (ds.groundtruth && ds.groundtruth->hasTimestamps() && ds.groundtruth_enu_origin) {
+    const Trajectory truth =
+        run::reexpressEnu(*ds.groundtruth, *ds.groundtruth_enu_origin, r.origin);
+    io::writeTum(out / "groundtruth.tum", truth);  // for gvio render's error view
+    evaluation = run::evaluateGnssIns(r, truth);
+  }
+  run::InsReportContext context;
+  context.command_line = common.command_line;
+  context.gnss_requested = opt.gnss;
+  context.gnss_noise = gnss_noise;
+  context.imu_noise_source = dataset_noise ? "dataset" : "config";
+  context.peak_rss_mb = run::peakRssMb();
+  context.evaluation = evaluation ? &*evaluation : nullptr;
+  io::writeTextAtomic(out / "report.json", run::gnssInsReport(ds, r, context).dump(2) + "\n");
+  io::writeTextAtomic(out / "config.yaml", dumpConfigYaml(config));
+  std::string figures;
+  if (evaluation && evaluation->fused_h && evaluation->raw_h) {
+    figures = fmt::format(
+        "; position rmse vs truth: fused {:.3f} m horizontal / {:.3f} m 3-D, raw fixes {:.3f} / "
+        "{:.3f} m",
+        evaluation->fused_h->rmse, evaluation->fused_3d->rmse, evaluation->raw_h->rmse,
+        evaluation->raw_3d->rmse);
+  }
+  spdlog::info(
+      "GNSS/INS: {} fixes used, {} rejected, {} before init, {} outage(s), time offset {:.3f} +- "
+      "{:.3f} s{}; wrote {}",
+      r.stats.fixes_used, r.stats.fixes_rejected, r.stats.fixes_before_init, r.stats.outages.size(),
+      r.final_state.time_offset_s, r.time_offset_sigma_s, figures, out.string());
+  return 0;
+}
+
 int runRun(const RunOptions& opt, const CommonOptions& common) {
   checkGnssOption(opt.gnss);
   const std::optional<run::TwoPassSpans> two_pass =
@@ -87,6 +133,9 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
   io::Dataset ds = io::readDataset(opt.dataset, io::parseDatasetFormat(opt.format), config.dataset);
   for (const auto& w : ds.warnings) spdlog::warn("{}", w);
   const nlohmann::json gnss_noise = degradeGnss(ds, opt.gnss_noise, opt.seed);
+  if (run::wantsGnssIns(ds) && opt.gnss != "off") {
+    return runGnssInsMode(opt, common, config, ds, gnss_noise);
+  }
 
   odometry::EstimatorConfig estimator = config.vio.estimator;
   estimator.mode = run::chooseVioMode(config.vio.mode, ds);
@@ -211,13 +260,16 @@ Command addRunCommand(CLI::App& app, const CommonOptions& common) {
   auto opt = std::make_shared<RunOptions>();
   CLI::App* sub =
       app.add_subcommand("run", "Visual-inertial odometry over a dataset, written as a run folder");
-  sub->add_option("--dataset", opt->dataset, "Dataset folder (KITTI raw drive, EuRoC)")->required();
+  sub->add_option("--dataset", opt->dataset,
+                  "Dataset folder (KITTI raw drive, EuRoC; comma2k19 CSV: IMU + GNSS without a "
+                  "camera runs GNSS/INS)")
+      ->required();
   sub->add_option("--format", opt->format, "Dataset format")
-      ->check(CLI::IsMember({"auto", "kitti-raw", "euroc"}))
+      ->check(CLI::IsMember({"auto", "kitti-raw", "euroc", "comma2k19"}))
       ->capture_default_str();
   sub->add_option("--gnss", opt->gnss,
                   "GNSS fusion: auto (graph when the dataset has fixes), off, kf (the reference "
-                  "Kalman filter) or graph")
+                  "Kalman filter) or graph; without camera frames any mode but off is GNSS/INS")
       ->capture_default_str();
   sub->add_option("--gnss-noise", opt->gnss_noise,
                   "Degrade the dataset's GNSS fixes: none, spp, rtk or a YAML noise-model file "

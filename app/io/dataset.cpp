@@ -2,6 +2,7 @@
 
 #include <fstream>
 
+#include "io/comma2k19.hpp"
 #include "io/euroc.hpp"
 #include "io/input_error.hpp"
 #include "io/kitti_raw.hpp"
@@ -43,6 +44,8 @@ std::string toString(DatasetFormat format) {
       return "euroc";
     case DatasetFormat::kNmea:
       return "nmea";
+    case DatasetFormat::kComma2k19:
+      return "comma2k19";
   }
   return "unknown";
 }
@@ -52,8 +55,9 @@ std::optional<DatasetFormat> parseDatasetFormat(const std::string& name) {
   if (name == "kitti-raw") return DatasetFormat::kKittiRaw;
   if (name == "euroc") return DatasetFormat::kEuroc;
   if (name == "nmea") return DatasetFormat::kNmea;
+  if (name == "comma2k19") return DatasetFormat::kComma2k19;
   throw InvalidInput("unknown dataset format '" + name +
-                     "' (expected auto, kitti-raw, euroc or nmea)");
+                     "' (expected auto, kitti-raw, euroc, nmea or comma2k19)");
 }
 
 DatasetFormat detectFormat(const fs::path& path) {
@@ -65,10 +69,11 @@ DatasetFormat detectFormat(const fs::path& path) {
   }
   if (looksLikeKittiRaw(path)) return DatasetFormat::kKittiRaw;
   if (!findEurocMav0(path).empty()) return DatasetFormat::kEuroc;
+  if (looksLikeComma2k19(path)) return DatasetFormat::kComma2k19;
   throw InputError(
       path, 0,
       "unrecognised dataset layout (expected a KITTI raw drive with oxts/ or image_00/, "
-      "or an EuRoC folder with mav0/)");
+      "an EuRoC folder with mav0/, or a comma2k19 folder with csv/imu.csv)");
 }
 
 Dataset readDataset(const fs::path& path, std::optional<DatasetFormat> format,
@@ -85,6 +90,9 @@ Dataset readDataset(const fs::path& path, std::optional<DatasetFormat> format,
       break;
     case DatasetFormat::kNmea:
       ds = readNmeaDataset(path, config);
+      break;
+    case DatasetFormat::kComma2k19:
+      ds = readComma2k19(path, config);
       break;
   }
   if (ds.frames.empty() && ds.imu.empty() && ds.gnss.empty()) {

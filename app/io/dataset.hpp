@@ -7,13 +7,14 @@
 #include <string>
 #include <vector>
 
+#include "fusion/geodesy.hpp"
 #include "io/reader_config.hpp"
 #include "odometry/measurements.hpp"
 #include "odometry/trajectory.hpp"
 
 namespace gvio::io {
 
-enum class DatasetFormat { kKittiRaw, kEuroc, kNmea };
+enum class DatasetFormat { kKittiRaw, kEuroc, kNmea, kComma2k19 };
 std::string toString(DatasetFormat format);
 
 // One camera trigger: the timestamp and one image path per camera (same order as cameras).
@@ -34,6 +35,9 @@ struct Dataset {
   std::string gnss_source;  // file the fixes came from, empty without GNSS
   std::optional<Trajectory> groundtruth;
   std::string groundtruth_source;
+  // Set when the truth was converted into the local ENU frame at this origin (comma2k19), so that
+  // a run in the same frame can be evaluated without alignment.
+  std::optional<fusion::Lla> groundtruth_enu_origin;
   std::vector<std::string> warnings;  // non-fatal defects found while reading (also logged)
 };
 
@@ -45,7 +49,8 @@ Dataset readDataset(const std::filesystem::path& path, std::optional<DatasetForm
 // Format detection from the folder layout; throws InputError when nothing matches.
 DatasetFormat detectFormat(const std::filesystem::path& path);
 
-// Parses "auto" (nullopt), "kitti-raw", "euroc", "nmea"; throws InvalidInput otherwise.
+// Parses "auto" (nullopt), "kitti-raw", "euroc", "nmea", "comma2k19"; throws InvalidInput
+// otherwise.
 std::optional<DatasetFormat> parseDatasetFormat(const std::string& name);
 
 }  // namespace gvio::io

@@ -30,6 +30,8 @@ void ReaderConfig::validate() const {
   requirePositive(nmea_uere_rtk_float_m, "dataset.nmea_uere_rtk_float_m");
   requirePositive(nmea_uere_rtk_fixed_m, "dataset.nmea_uere_rtk_fixed_m");
   requirePositive(nmea_vertical_factor, "dataset.nmea_vertical_factor");
+  requirePositive(comma2k19_sigma_h_m, "dataset.comma2k19_sigma_h_m");
+  requirePositive(comma2k19_sigma_v_m, "dataset.comma2k19_sigma_v_m");
 }
 
 }  // namespace gvio::io

@@ -17,6 +17,9 @@ struct ReaderConfig {
   double nmea_uere_rtk_fixed_m = 0.02;
   // Vertical sigma = horizontal sigma x this (VDOP is typically 1.5-2 x HDOP).
   double nmea_vertical_factor = 2.0;
+  // comma2k19's u-blox CSV has no accuracy columns: 1-sigma horizontal (per axis) and vertical.
+  double comma2k19_sigma_h_m = 1.0;
+  double comma2k19_sigma_v_m = 2.0;
 
   void validate() const;  // throws InvalidInput naming the key
 };

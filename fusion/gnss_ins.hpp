@@ -1,0 +1,135 @@
+#pragma once
+// GNSS/INS without a camera: a loosely coupled error-state Kalman filter in local ENU (Groves,
+// "Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems", 2nd ed., ch. 14;
+// Sola 2017, "Quaternion kinematics for the error-state Kalman filter"). The IMU propagates the
+// nominal state (fusion/ins_error_model.hpp); GNSS fixes correct it with their antenna position
+// (lever arm, per-fix sigma, first-order receiver time offset, optionally estimated) and, when the
+// receiver reports it, the horizontal velocity from speed and course. Innovations are chi-square
+// gated with a bounded number of consecutive rejections; periods without accepted fixes are coasted
+// on the IMU and reported as outages.
+//
+// Initialisation (moving start; a static start waits until the vehicle moves): roll and pitch from
+// the mean specific force of the last init_window_s of IMU samples, corrected by the GNSS-measured
+// acceleration over that window; heading from the GNSS course (the body x axis is taken as the
+// direction of travel, as for a car's IMU); velocity from speed and course (or differenced fixes).
+#include <Eigen/Core>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "fusion/geodesy.hpp"
+#include "fusion/ins_error_model.hpp"
+#include "odometry/measurements.hpp"
+#include "odometry/trajectory.hpp"
+
+namespace gvio::fusion {
+
+struct InsConfig {
+  // Shared with the camera fusion (the app copies fusion.lever_arm_b, receiver_time_offset_s,
+  // gate_chi2, max_consecutive_rejections and outage_s into these).
+  Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();  // GNSS antenna in the body frame (m)
+  double receiver_time_offset_s = 0.0;  // a fix stamped t is the antenna position at t + this
+  double gate_chi2 = 16.27;             // position innovation gate (3 dof, 99.9 %)
+  int max_consecutive_rejections = 5;   // then the next fix is accepted (re-convergence)
+  double outage_s = 3.0;                // no accepted fix for longer than this is an outage
+  ImuNoise imu;                         // the app sets imu.* (or the dataset's own noise)
+
+  // INS-only settings (fusion.ins.*).
+  bool estimate_time_offset = true;       // the receiver time offset is a filter state
+  double time_offset_sigma_s = 0.1;       // its initial 1-sigma around receiver_time_offset_s
+  double time_offset_random_walk = 1e-4;  // s/sqrt(s)
+  bool use_velocity = true;               // fuse speed + course when the receiver reports them
+  double velocity_sigma_mps = 0.2;        // 1-sigma per horizontal axis of that velocity
+  double velocity_min_speed_mps = 2.0;    // below this the course is not used
+  double velocity_gate_chi2 = 13.82;      // velocity innovation gate (2 dof, 99.9 %)
+  double init_window_s = 1.0;             // IMU samples averaged for roll / pitch
+  double init_min_speed_mps = 3.0;      // GNSS speed at which the heading is taken from the course
+  double init_tilt_sigma_deg = 2.0;     // initial roll / pitch 1-sigma
+  double init_heading_sigma_deg = 5.0;  // initial heading 1-sigma
+  double init_velocity_sigma_mps = 0.5;
+  double init_acc_bias_sigma_mps2 = 0.2;
+  double init_gyr_bias_sigma_radps = 0.005;
+  double max_imu_gap_s = 0.1;  // longer IMU periods are counted as gaps (still integrated)
+
+  void validate() const;  // throws InvalidInput naming the key (fusion.ins.*)
+};
+
+enum class InsFixStatus { kUsed, kRejected, kBeforeInit };
+
+struct InsFixOutcome {
+  std::int64_t t_ns = 0;                            // the fix's stamp
+  Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();  // the antenna position it reports
+  InsFixStatus status = InsFixStatus::kUsed;
+};
+
+struct InsStats {
+  int imu_samples = 0;
+  int imu_gaps = 0;
+  int imu_before_init = 0;
+  int fixes_used = 0;
+  int fixes_rejected = 0;     // chi-square gate
+  int fixes_forced = 0;       // accepted after max_consecutive_rejections (among fixes_used)
+  int fixes_before_init = 0;  // waiting for motion (heading) and the IMU window
+  int velocity_used = 0;
+  int velocity_rejected = 0;
+  std::optional<std::int64_t> t_init_ns;
+  std::vector<std::pair<std::int64_t, std::int64_t>> outages;  // [t0, t1] without accepted fixes
+  std::vector<double> ms_per_fix;                              // update cost of each fix
+  std::vector<InsFixOutcome> fixes;                            // every fix given, in time order
+};
+
+class GnssIns {
+ public:
+  GnssIns(const InsConfig& config, const EnuFrame& enu);
+
+  // IMU samples and fixes in one time-ordered stream: a fix is given before the first IMU sample
+  // later than its stamp. Fixes are applied at the filter time of the last IMU sample (causal).
+  void addImu(const ImuSample& sample);
+  void addFix(const GnssFix& fix);
+  // Closes the last outage at the last IMU sample.
+  void finish();
+
+  [[nodiscard]] bool initialized() const { return initialized_; }
+  [[nodiscard]] const InsState& state() const { return x_; }
+  [[nodiscard]] const InsMatrix& covariance() const { return P_; }
+  // T_enu_b after every IMU sample from initialisation on.
+  [[nodiscard]] const Trajectory& trajectory() const { return trajectory_; }
+  [[nodiscard]] const InsStats& stats() const { return stats_; }
+
+ private:
+  struct FixVelocity {
+    std::int64_t t_ns = 0;
+    Eigen::Vector2d v_en = Eigen::Vector2d::Zero();
+  };
+
+  void tryInitialize(const GnssFix& fix, const Eigen::Vector3d& p_ant_enu);
+  void updatePosition(const GnssFix& fix, const Eigen::Vector3d& p_ant_enu);
+  void updateVelocity(const GnssFix& fix);
+  // Kalman update with gating; returns true when applied.
+  template <int Rows>
+  bool update(const InsMeasurement<Rows>& m, const Eigen::Matrix<double, Rows, 1>& z,
+              const Eigen::Matrix<double, Rows, Rows>& R, double gate_chi2, bool force);
+  void recordPose();
+  [[nodiscard]] double stampMinusFilter(std::int64_t t_ns) const;
+
+  InsConfig config_;
+  EnuFrame enu_;
+  bool initialized_ = false;
+  InsState x_;
+  InsMatrix P_ = InsMatrix::Zero();
+  std::optional<ImuSample> last_imu_;
+  std::deque<ImuSample> init_imu_;      // the last init_window_s of samples before initialisation
+  std::deque<FixVelocity> init_fix_v_;  // GNSS velocities over the same window
+  std::optional<std::pair<std::int64_t, Eigen::Vector3d>> prev_fix_;  // for differenced velocity
+  std::optional<std::int64_t> last_accepted_ns_;
+  int consecutive_rejections_ = 0;
+  Trajectory trajectory_;
+  InsStats stats_;
+};
+
+// The horizontal velocity a fix reports (east, north), from speed and course; nullopt without.
+std::optional<Eigen::Vector2d> fixVelocityEn(const GnssFix& fix);
+
+}  // namespace gvio::fusion
