@@ -107,30 +107,27 @@ void writeGnssFixes(const std::filesystem::path& file, const GnssRunResult& r) {
   });
 }
 
-void writeGeoreferencedOutputs(const std::filesystem::path& out, const GnssRunResult& r) {
-  writeGnssFixes(out / "gnss_fixes.csv", r);
-  if (r.fused.empty()) return;
-  io::writeTum(out / "trajectory.tum", r.fused);
-  if (!r.fused_online.empty()) io::writeTum(out / "trajectory_online.tum", r.fused_online);
-  if (!r.fused_covariance.empty()) {
-    writeCovariance(out / "trajectory_cov.csv", r.fused, r.fused_covariance);
-  }
-  const fusion::EnuFrame enu(r.origin);
-  io::writeFileAtomic(out / "trajectory_lla.csv", [&](std::ostream& os) {
+void writeTrajectoryLla(const std::filesystem::path& file, const Trajectory& T_enu_b,
+                        const fusion::Lla& origin) {
+  const fusion::EnuFrame enu(origin);
+  io::writeFileAtomic(file, [&](std::ostream& os) {
     os << "# t_s,lat_deg,lon_deg,h_ellipsoid_m,qw,qx,qy,qz (body in local ENU)\n";
-    for (std::size_t k = 0; k < r.fused.size(); ++k) {
-      const fusion::Lla lla = enu.toLla(r.fused.poses[k].translation());
-      const Eigen::Quaterniond q(r.fused.poses[k].rotation());
+    for (std::size_t k = 0; k < T_enu_b.size(); ++k) {
+      const fusion::Lla lla = enu.toLla(T_enu_b.poses[k].translation());
+      const Eigen::Quaterniond q(T_enu_b.poses[k].rotation());
       os << fmt::format("{:.9f},{:.9f},{:.9f},{:.4f},{:.9f},{:.9f},{:.9f},{:.9f}\n",
-                        seconds(r.fused.t_ns[k]), lla.lat_deg, lla.lon_deg, lla.h_ellipsoid_m,
+                        seconds(T_enu_b.t_ns[k]), lla.lat_deg, lla.lon_deg, lla.h_ellipsoid_m,
                         q.w(), q.x(), q.y(), q.z());
     }
   });
-  const fusion::Utm utm = fusion::llaToUtm(r.origin);
+}
+
+nlohmann::json georefJson(const fusion::Lla& origin) {
+  const fusion::Utm utm = fusion::llaToUtm(origin);
   nlohmann::json j;
-  j["enu_origin"] = {{"lat_deg", r.origin.lat_deg},
-                     {"lon_deg", r.origin.lon_deg},
-                     {"h_ellipsoid_m", r.origin.h_ellipsoid_m},
+  j["enu_origin"] = {{"lat_deg", origin.lat_deg},
+                     {"lon_deg", origin.lon_deg},
+                     {"h_ellipsoid_m", origin.h_ellipsoid_m},
                      {"crs", "EPSG:4979"}};
   j["utm"] = {{"zone", utm.zone},
               {"north", utm.north},
@@ -139,8 +136,21 @@ void writeGeoreferencedOutputs(const std::filesystem::path& out, const GnssRunRe
               {"origin_northing_m", utm.northing_m}};
   j["frames"] = {
       {"enu", "local east-north-up tangent at enu_origin (GeographicLib LocalCartesian), metres"},
-      {"body", "the IMU frame; trajectory.tum and trajectory_lla.csv give the body pose in ENU"},
-      {"vio_world", "trajectory_vio.tum's frame; T_enu_w maps it to ENU"}};
+      {"body", "the IMU frame; trajectory.tum and trajectory_lla.csv give the body pose in ENU"}};
+  return j;
+}
+
+void writeGeoreferencedOutputs(const std::filesystem::path& out, const GnssRunResult& r) {
+  writeGnssFixes(out / "gnss_fixes.csv", r);
+  if (r.fused.empty()) return;
+  io::writeTum(out / "trajectory.tum", r.fused);
+  if (!r.fused_online.empty()) io::writeTum(out / "trajectory_online.tum", r.fused_online);
+  if (!r.fused_covariance.empty()) {
+    writeCovariance(out / "trajectory_cov.csv", r.fused, r.fused_covariance);
+  }
+  writeTrajectoryLla(out / "trajectory_lla.csv", r.fused, r.origin);
+  nlohmann::json j = georefJson(r.origin);
+  j["frames"]["vio_world"] = "trajectory_vio.tum's frame; T_enu_w maps it to ENU";
   if (r.T_enu_w) {
     const Eigen::Quaterniond q(r.T_enu_w->rotation());
     const Eigen::Vector3d t = r.T_enu_w->translation();

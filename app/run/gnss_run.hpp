@@ -38,6 +38,15 @@ std::optional<GnssRunResult> fuseGnss(const io::Dataset& dataset, const Trajecto
 // ("t_s,e_m,n_m,u_m,status", status used | rejected | unmatched | unaligned).
 void writeGnssFixes(const std::filesystem::path& file, const GnssRunResult& result);
 
+// trajectory_lla.csv: `t_s,lat_deg,lon_deg,h_ellipsoid_m,qw,qx,qy,qz` of the body poses T_enu_b in
+// the local ENU frame at `origin` (shared with the GNSS/INS run).
+void writeTrajectoryLla(const std::filesystem::path& file, const Trajectory& T_enu_b,
+                        const fusion::Lla& origin);
+
+// georef.json's common part: the ENU origin (EPSG:4979), its UTM zone / EPSG and easting/northing,
+// and the enu and body frames; each run adds its own frames, heights and time base.
+nlohmann::json georefJson(const fusion::Lla& origin);
+
 // gnss_fixes.csv, and when the fusion registered: trajectory.tum (T_enu_b), trajectory_lla.csv (t,
 // lat, lon, h, qw qx qy qz of the body in ENU), georef.json and, when trajectory.tum is the
 // smoothed one, trajectory_online.tum (causal) and trajectory_cov.csv (each smoothed pose's

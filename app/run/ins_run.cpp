@@ -145,31 +145,8 @@ void writeGnssInsOutputs(const std::filesystem::path& out, const InsRunResult& r
   writeGnssFixes(out / "gnss_fixes.csv", fixes);
   if (r.fused.empty()) return;
   io::writeTum(out / "trajectory.tum", r.fused);
-  const fusion::EnuFrame enu(r.origin);
-  io::writeFileAtomic(out / "trajectory_lla.csv", [&](std::ostream& os) {
-    os << "# t_s,lat_deg,lon_deg,h_ellipsoid_m,qw,qx,qy,qz (body in local ENU)\n";
-    for (std::size_t k = 0; k < r.fused.size(); ++k) {
-      const fusion::Lla lla = enu.toLla(r.fused.poses[k].translation());
-      const Eigen::Quaterniond q(r.fused.poses[k].rotation());
-      os << fmt::format("{:.9f},{:.9f},{:.9f},{:.4f},{:.9f},{:.9f},{:.9f},{:.9f}\n",
-                        seconds(r.fused.t_ns[k]), lla.lat_deg, lla.lon_deg, lla.h_ellipsoid_m,
-                        q.w(), q.x(), q.y(), q.z());
-    }
-  });
-  const fusion::Utm utm = fusion::llaToUtm(r.origin);
-  json j;
-  j["enu_origin"] = {{"lat_deg", r.origin.lat_deg},
-                     {"lon_deg", r.origin.lon_deg},
-                     {"h_ellipsoid_m", r.origin.h_ellipsoid_m},
-                     {"crs", "EPSG:4979"}};
-  j["utm"] = {{"zone", utm.zone},
-              {"north", utm.north},
-              {"epsg", utm.epsg()},
-              {"origin_easting_m", utm.easting_m},
-              {"origin_northing_m", utm.northing_m}};
-  j["frames"] = {
-      {"enu", "local east-north-up tangent at enu_origin (GeographicLib LocalCartesian), metres"},
-      {"body", "the IMU frame; trajectory.tum and trajectory_lla.csv give the body pose in ENU"}};
+  writeTrajectoryLla(out / "trajectory_lla.csv", r.fused, r.origin);
+  json j = georefJson(r.origin);
   j["heights"] = "ellipsoidal (WGS84)";
   j["time_base"] =
       "dataset timestamps in seconds (the IMU clock; GNSS fixes are corrected by the estimated "
