@@ -32,6 +32,25 @@ DenseFusion::TileKey DenseFusion::tileOf(const pcl::PointXYZI& p) const {
           static_cast<std::int64_t>(std::floor(static_cast<double>(p.z) / tile_size_m_))};
 }
 
+DenseFusion::TilePoint DenseFusion::pack(const pcl::PointXYZI& p) {
+  const float i = std::clamp(p.intensity, 0.0f, 255.0f);
+  return {p.x, p.y, p.z, static_cast<std::uint8_t>(std::lround(i))};
+}
+
+pcl::PointXYZI DenseFusion::unpack(const TilePoint& t) {
+  pcl::PointXYZI p;
+  p.x = t.x, p.y = t.y, p.z = t.z;
+  p.intensity = static_cast<float>(t.intensity);
+  return p;
+}
+
+CameraCloud DenseFusion::toCloud(const std::vector<TilePoint>& points) {
+  CameraCloud cloud;
+  cloud.reserve(points.size());
+  for (const TilePoint& t : points) cloud.push_back(unpack(t));
+  return cloud;
+}
+
 void DenseFusion::add(const CameraCloud& points_map) {
   std::map<TileKey, Tile*> touched;
   for (const auto& p : points_map) {
@@ -39,7 +58,7 @@ void DenseFusion::add(const CameraCloud& points_map) {
     const TileKey key = tileOf(p);
     auto it = touched.find(key);
     if (it == touched.end()) it = touched.emplace(key, &tiles_[key]).first;
-    it->second->points.push_back(p);
+    it->second->points.push_back(pack(p));
     ++points_added_;
   }
   for (auto& [key, tile] : touched) {
@@ -49,14 +68,19 @@ void DenseFusion::add(const CameraCloud& points_map) {
   }
 }
 
-void DenseFusion::compact(Tile& tile) const {
-  tile.points = voxelDownsample(tile.points, voxel_size_m_);
+void DenseFusion::compact(Tile& tile, bool final) const {
+  const CameraCloud voxels = voxelDownsample(toCloud(tile.points), voxel_size_m_);
+  std::vector<TilePoint> packed;
+  // Room for the growth that triggers the next compaction, so the vector never doubles past it.
+  packed.reserve(final ? voxels.size() : std::max(kMinCompactPoints, voxels.size() * 3 / 2) + 1);
+  for (const auto& p : voxels) packed.push_back(pack(p));
+  tile.points.swap(packed);
   tile.compacted_size = tile.points.size();
 }
 
 CameraCloud DenseFusion::withMargin(const TileKey& key) const {
   const Tile& own = tiles_.at(key);
-  CameraCloud out = own.points;
+  CameraCloud out = toCloud(own.points);
   const double margin = marginOf(voxel_size_m_);
   Eigen::Vector3d lo, hi;
   for (int a = 0; a < 3; ++a) {
@@ -69,11 +93,9 @@ CameraCloud DenseFusion::withMargin(const TileKey& key) const {
         if (dx == 0 && dy == 0 && dz == 0) continue;
         const auto it = tiles_.find({key[0] + dx, key[1] + dy, key[2] + dz});
         if (it == tiles_.end()) continue;
-        for (const auto& p : it->second.points) {
-          const Eigen::Array3d q = p.getArray3fMap().cast<double>();
-          if ((q >= lo.array()).all() && (q < hi.array()).all()) {
-            out.push_back(p);
-          }
+        for (const TilePoint& t : it->second.points) {
+          const Eigen::Array3d q(t.x, t.y, t.z);
+          if ((q >= lo.array()).all() && (q < hi.array()).all()) out.push_back(unpack(t));
         }
       }
     }
@@ -88,10 +110,10 @@ void DenseFusion::keepBorder(const TileKey& key, Tile& tile) const {
     lo[a] = static_cast<double>(key[static_cast<std::size_t>(a)]) * tile_size_m_ + margin;
     hi[a] = static_cast<double>(key[static_cast<std::size_t>(a)] + 1) * tile_size_m_ - margin;
   }
-  CameraCloud border;
-  for (const auto& p : tile.points) {
-    const Eigen::Array3d q = p.getArray3fMap().cast<double>();
-    if (!((q >= lo).all() && (q < hi).all())) border.push_back(p);
+  std::vector<TilePoint> border;
+  for (const TilePoint& t : tile.points) {
+    const Eigen::Array3d q(t.x, t.y, t.z);
+    if (!((q >= lo).all() && (q < hi).all())) border.push_back(t);
   }
   tile.points.swap(border);
 }
@@ -99,7 +121,7 @@ void DenseFusion::keepBorder(const TileKey& key, Tile& tile) const {
 MapCloud DenseFusion::finish() {
   points_after_voxel_ = 0;
   for (auto& [key, tile] : tiles_) {
-    compact(tile);
+    compact(tile, true);
     points_after_voxel_ += tile.points.size();
   }
   MapCloud out;
@@ -120,7 +142,7 @@ MapCloud DenseFusion::finish() {
       sor.setStddevMulThresh(sor_stddev_mul_);
       sor.filter(kept);
     } else {
-      kept = tile.points;  // too few points for the statistic: nothing to compare them with
+      kept = toCloud(tile.points);  // too few points for the statistic: nothing to compare with
     }
     for (const auto& p : kept) {
       out.push_back(makeMapPoint(p.x, p.y, p.z, p.intensity, 0, MapPointSource::kDenseStereo));
