@@ -35,6 +35,13 @@ std::size_t KeyframeStore::addKeyframe(std::int64_t t_ns, const Eigen::Isometry3
   return keyframes_.size() - 1;
 }
 
+void KeyframeStore::releaseDense(std::size_t index) {
+  StoredKeyframe& kf = keyframes_.at(index);
+  dense_points_ -= kf.dense_c.size();
+  std::vector<PackedPoint>().swap(kf.dense_c);
+  kf.has_dense = false;
+}
+
 void KeyframeStore::setDense(std::size_t index, const CameraCloud& points_c) {
   StoredKeyframe& kf = keyframes_.at(index);
   dense_points_ -= kf.dense_c.size();

@@ -45,6 +45,9 @@ class KeyframeStore {
   std::size_t addKeyframe(std::int64_t t_ns, const Eigen::Isometry3d& T_w_b);
   // Dense points of keyframe `index` (left camera frame); points beyond +-32.7 m are dropped.
   void setDense(std::size_t index, const CameraCloud& points_c);
+  // Frees keyframe `index`'s dense points (after the map has used them); it then contributes its
+  // landmarks only, like a keyframe without depth.
+  void releaseDense(std::size_t index);
   // Attaches landmark `id` to keyframe `index` with its latest estimate; `intensity` < 0 keeps
   // the previous intensity (the landmark did not project into this keyframe's image).
   void updateLandmark(std::uint64_t id, std::size_t index, const Eigen::Vector3d& p_b,

@@ -127,6 +127,14 @@ CameraCloud MapBuilder::pointsOf(std::size_t index, const Eigen::Isometry3d& T_t
 }
 
 MapBuildResult MapBuilder::build(const PoseLookup& pose_of) const {
+  return buildImpl(pose_of, nullptr);
+}
+
+MapBuildResult MapBuilder::buildReleasing(const PoseLookup& pose_of) {
+  return buildImpl(pose_of, &store_);
+}
+
+MapBuildResult MapBuilder::buildImpl(const PoseLookup& pose_of, KeyframeStore* release) const {
   MapBuildResult result;
   MapCounts& counts = result.counts;
   const auto& keyframes = store_.keyframes();
@@ -165,6 +173,7 @@ MapBuildResult MapBuilder::build(const PoseLookup& pose_of) const {
     const auto start = Clock::now();
     occupancy.insert(points, *poses[i] * camera_.T_b_c.translation());
     result.ms_octomap_per_keyframe.push_back(msSince(start));
+    if (release != nullptr && keyframes[i].has_dense) release->releaseDense(i);
   }
   counts.dense_points_raw = fusion.pointsAdded();
 

@@ -78,6 +78,10 @@ class MapBuilder {
 
   // Rebuilds the whole map in the frame pose_of maps into.
   [[nodiscard]] MapBuildResult build(const PoseLookup& pose_of) const;
+  // The same, freeing each keyframe's dense points once they are in the map, so that the store
+  // and the map are not both held (a long drive's largest structures). Afterwards the keyframes
+  // contribute their landmarks only (keyframePoints, build).
+  [[nodiscard]] MapBuildResult buildReleasing(const PoseLookup& pose_of);
 
   // Points of the keyframes with t0_ns <= t_ns <= t1_ns in the target frame, without the global
   // filters: dense points where the keyframe has them, else the landmarks attached to it that
@@ -94,6 +98,8 @@ class MapBuilder {
   [[nodiscard]] const MapConfig& config() const { return config_; }
 
  private:
+  // `release`: this builder's store, to free each keyframe's dense points once used; or null.
+  [[nodiscard]] MapBuildResult buildImpl(const PoseLookup& pose_of, KeyframeStore* release) const;
   [[nodiscard]] bool landmarkAccepted(const StoredLandmark& lm) const;
   // The points a keyframe contributes, in the target frame (see keyframePoints).
   [[nodiscard]] CameraCloud pointsOf(std::size_t index, const Eigen::Isometry3d& T_target_b,

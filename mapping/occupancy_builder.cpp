@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <sstream>
 #include <unordered_map>
+#include <utility>
+#include <vector>
 
 namespace gvio::mapping {
 namespace {
@@ -15,7 +16,9 @@ constexpr std::size_t kMinCompactNodes = 200'000;
 }  // namespace
 
 OccupancyBuilder::OccupancyBuilder(const OccupancyConfig& config)
-    : config_(config), color_tree_(std::make_unique<octomap::ColorOcTree>(config.resolution_m)) {}
+    : config_(config),
+      tree_(std::make_unique<octomap::OcTree>(config.resolution_m)),
+      color_tree_(std::make_unique<octomap::ColorOcTree>(config.resolution_m)) {}
 
 void OccupancyBuilder::insert(const CameraCloud& points_map, const Eigen::Vector3d& origin_map) {
   if (points_map.empty()) return;
@@ -29,11 +32,13 @@ void OccupancyBuilder::insert(const CameraCloud& points_map, const Eigen::Vector
   // What insertPointCloud(scan, origin, max_range, lazy_eval = true, discretize = true) does,
   // keeping the occupied keys for the colours.
   octomap::KeySet free_cells, occupied_cells;
-  color_tree_->computeDiscreteUpdate(scan, origin, free_cells, occupied_cells, config_.max_range_m);
-  for (const auto& key : free_cells) color_tree_->updateNode(key, false, true);
-  for (const auto& key : occupied_cells) color_tree_->updateNode(key, true, true);
+  tree_->computeDiscreteUpdate(scan, origin, free_cells, occupied_cells, config_.max_range_m);
+  for (const auto& key : free_cells) tree_->updateNode(key, false, true);
+  for (const auto& key : occupied_cells) tree_->updateNode(key, true, true);
 
-  // Mean grey value of the scan's points in each occupied voxel, merged into the voxel's colour.
+  // Mean grey value of the scan's points in each occupied voxel, merged into the voxel's colour
+  // in the colour tree (which holds the hit voxels only; finish() gives them the OcTree's
+  // occupancy).
   struct Sum {
     double intensity = 0.0;
     int n = 0;
@@ -41,7 +46,7 @@ void OccupancyBuilder::insert(const CameraCloud& points_map, const Eigen::Vector
   std::unordered_map<octomap::OcTreeKey, Sum, octomap::OcTreeKey::KeyHash> sums;
   for (const auto& p : points_map) {
     octomap::OcTreeKey key;
-    if (!color_tree_->coordToKeyChecked(octomap::point3d(p.x, p.y, p.z), key)) continue;
+    if (!tree_->coordToKeyChecked(octomap::point3d(p.x, p.y, p.z), key)) continue;
     if (occupied_cells.count(key) == 0) continue;  // beyond the max range
     Sum& s = sums[key];
     s.intensity += static_cast<double>(p.intensity);
@@ -50,41 +55,40 @@ void OccupancyBuilder::insert(const CameraCloud& points_map, const Eigen::Vector
   for (const auto& [key, s] : sums) {
     const double grey = std::clamp(std::round(s.intensity / s.n), 0.0, 255.0);
     const auto g = static_cast<std::uint8_t>(grey);
+    color_tree_->updateNode(key, true, true);
     color_tree_->averageNodeColor(key, g, g, g);
   }
 
-  if (color_tree_->size() >= std::max(kMinCompactNodes, nodes_after_compact_ * 3 / 2)) compact();
+  if (tree_->size() >= std::max(kMinCompactNodes, nodes_after_compact_ * 3 / 2)) compact();
 }
 
 void OccupancyBuilder::compact() {
-  color_tree_->updateInnerOccupancy();
-  color_tree_->prune();
-  nodes_after_compact_ = color_tree_->size();
+  tree_->updateInnerOccupancy();
+  tree_->prune();
+  nodes_after_compact_ = tree_->size();
 }
 
 OccupancyBuilder::Trees OccupancyBuilder::finish() {
   compact();
+  // Each coloured (hit) voxel takes the OcTree's final occupancy there: a voxel hit once and
+  // cleared by later rays is free in both trees.
+  std::vector<std::pair<octomap::OcTreeKey, float>> log_odds;
+  log_odds.reserve(color_tree_->getNumLeafNodes());
+  for (auto it = color_tree_->begin_leafs(); it != color_tree_->end_leafs(); ++it) {
+    const octomap::OcTreeNode* node = tree_->search(it.getKey());
+    log_odds.emplace_back(it.getKey(),
+                          node != nullptr ? node->getLogOdds() : tree_->getClampingThresMinLog());
+  }
+  for (const auto& [key, value] : log_odds) color_tree_->setNodeValue(key, value, true);
+  color_tree_->updateInnerOccupancy();
+  color_tree_->prune();
   Trees trees;
-  trees.occupancy = maximumLikelihoodOcTree(*color_tree_);
+  trees.occupancy = std::move(tree_);
   trees.color = std::move(color_tree_);
+  tree_ = std::make_unique<octomap::OcTree>(config_.resolution_m);
   color_tree_ = std::make_unique<octomap::ColorOcTree>(config_.resolution_m);
   nodes_after_compact_ = 0;
   return trees;
-}
-
-std::unique_ptr<octomap::OcTree> maximumLikelihoodOcTree(const octomap::ColorOcTree& tree) {
-  auto ml = std::make_unique<octomap::OcTree>(tree.getResolution());
-  ml->setOccupancyThres(tree.getOccupancyThres());
-  ml->setClampingThresMin(tree.getClampingThresMin());
-  ml->setClampingThresMax(tree.getClampingThresMax());
-  if (tree.size() == 0) return ml;
-  // OctoMap's binary (.bt) tree stream: two bits per child (unknown, free, occupied, inner).
-  std::stringstream stream;
-  tree.writeBinaryData(stream);
-  ml->readBinaryData(stream);
-  ml->updateInnerOccupancy();
-  ml->prune();
-  return ml;
 }
 
 }  // namespace gvio::mapping

@@ -188,12 +188,14 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
   nlohmann::json map_report;
   if (recorder && !recorder->empty()) {
     const Trajectory* fused = gnss && !gnss->fused.empty() ? &gnss->fused : nullptr;
+    nlohmann::json two_pass_report;
+    if (two_pass) {  // before the build, which frees the keyframes' dense points
+      two_pass_report = run::twoPassReport(*recorder, run::mapPoses(*recorder, fused), *two_pass,
+                                           ds.frames.front().t_ns);
+    }
     run::MapRunResult map = run::buildMap(*recorder, fused);
     map_report = run::mapReport(*recorder, map);
-    if (two_pass) {
-      map_report["two_pass"] = run::twoPassReport(*recorder, run::mapPoses(*recorder, fused),
-                                                  *two_pass, ds.frames.front().t_ns);
-    }
+    if (two_pass) map_report["two_pass"] = two_pass_report;
     recorder.reset();  // the keyframe store is rebuilt into `map`: free it before writing
     map_report["las"] = run::writeMapFiles(out, map);
     spdlog::info("map ({}): {} landmarks, {} dense points, {} occupied voxels", map.frame,

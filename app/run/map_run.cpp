@@ -83,11 +83,11 @@ mapping::PoseLookup mapPoses(const MapRecorder& recorder, const Trajectory* fuse
   return [fused](std::int64_t t_ns) { return fusion::interpolatePose(*fused, t_ns); };
 }
 
-MapRunResult buildMap(const MapRecorder& recorder, const Trajectory* fused) {
+MapRunResult buildMap(MapRecorder& recorder, const Trajectory* fused) {
   const auto start = std::chrono::steady_clock::now();
   MapRunResult r;
   r.frame = fused != nullptr && !fused->empty() ? "enu" : "vio_world";
-  r.map = recorder.builder().build(mapPoses(recorder, fused));
+  r.map = recorder.buildReleasing(mapPoses(recorder, fused));
   r.build_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return r;

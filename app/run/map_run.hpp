@@ -28,6 +28,11 @@ class MapRecorder {
 
   [[nodiscard]] bool empty() const { return !builder_; }
   [[nodiscard]] const mapping::MapBuilder& builder() const { return *builder_; }
+  // The map, freeing the stored dense points as they go in (mapping::MapBuilder::buildReleasing):
+  // take every other look at the keyframes (e.g. --two-pass) before.
+  [[nodiscard]] mapping::MapBuildResult buildReleasing(const mapping::PoseLookup& pose_of) {
+    return builder_->buildReleasing(pose_of);
+  }
   [[nodiscard]] const std::vector<mapping::KeyframeTimings>& timings() const { return timings_; }
 
  private:
@@ -49,7 +54,8 @@ mapping::PoseLookup mapPoses(const MapRecorder& recorder, const Trajectory* fuse
 
 // Builds the map with the fused trajectory's poses (interpolated at the keyframe stamps) when
 // `fused` is given and not empty, else with the keyframes' VIO poses.
-MapRunResult buildMap(const MapRecorder& recorder, const Trajectory* fused);
+// Frees the recorder's dense points as they go into the map (MapRecorder::buildReleasing).
+MapRunResult buildMap(MapRecorder& recorder, const Trajectory* fused);
 
 // map.bt, map.ot, map.pcd (binary compressed), map.ply (binary) and map.las, each atomically.
 // map.las (LAS 1.4 in UTM + ellipsoidal height, through the run's georef.json with

@@ -213,6 +213,13 @@ TEST(MappingBuilder, DenseCloudIsVoxelDownsampledAndFollowsPoses) {
   }
   // Occupancy from dense keyframes: the plane is occupied.
   EXPECT_GT(map.counts.occupied_leaves, 1000u);
+
+  // Building while freeing the stored points gives the same map and leaves no dense point.
+  const MapBuildResult released = builder.buildReleasing(builder.vioPoses());
+  EXPECT_EQ(released.dense.size(), map.dense.size());
+  EXPECT_EQ(released.counts.occupied_leaves, map.counts.occupied_leaves);
+  EXPECT_EQ(builder.store().densePointCount(), 0u);
+  EXPECT_TRUE(builder.keyframePoints(1, 2, builder.vioPoses()).empty());
 }
 
 TEST(MappingBuilder, EveryNthKeyframeGetsDepth) {
@@ -285,8 +292,18 @@ TEST(MappingBuilder, WallIsOccupiedAndTheSpaceBeforeItFree) {
   ASSERT_NE(node, nullptr);
   EXPECT_TRUE(node->isColorSet());
 
-  // The OcTree is the maximum-likelihood copy of the colour tree: same classification as an
-  // OcTree filled directly by OctoMap's own insertion of the same scans.
+  // Every coloured voxel has the OcTree's classification.
+  std::size_t coloured = 0;
+  for (auto it = map.occupancy_color->begin_leafs(); it != map.occupancy_color->end_leafs();
+       ++it, ++coloured) {
+    const auto* mine = tree.search(it.getKey());
+    ASSERT_NE(mine, nullptr);
+    EXPECT_EQ(tree.isNodeOccupied(mine), map.occupancy_color->isNodeOccupied(*it));
+  }
+  EXPECT_GE(coloured, 400u);
+
+  // The OcTree has the same classification as one filled by OctoMap's own insertion of the same
+  // scans.
   octomap::OcTree direct(0.2);
   const auto scan = [&](std::size_t begin, std::size_t end) {
     octomap::Pointcloud pc;
