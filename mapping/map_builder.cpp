@@ -177,8 +177,12 @@ MapBuildResult MapBuilder::buildImpl(const PoseLookup& pose_of, KeyframeStore* r
   }
   counts.dense_points_raw = fusion.pointsAdded();
 
-  // The trees first: pruned to their maximum-likelihood form they take half the memory before
-  // the dense filters allocate the map cloud.
+  const auto start = Clock::now();
+  result.dense = fusion.finish();
+  result.ms_dense_fusion = msSince(start);
+  counts.dense_points_voxel = fusion.pointsAfterVoxel();
+  counts.dense_points = result.dense.size();
+
   auto trees = occupancy.finish();
   result.occupancy = std::move(trees.occupancy);
   result.occupancy_color = std::move(trees.color);
@@ -187,12 +191,6 @@ MapBuildResult MapBuilder::buildImpl(const PoseLookup& pose_of, KeyframeStore* r
   }
   counts.octree_bytes = result.occupancy->memoryUsage();
   counts.color_octree_bytes = result.occupancy_color->memoryUsage();
-
-  const auto start = Clock::now();
-  result.dense = fusion.finish();
-  result.ms_dense_fusion = msSince(start);
-  counts.dense_points_voxel = fusion.pointsAfterVoxel();
-  counts.dense_points = result.dense.size();
   return result;
 }
 

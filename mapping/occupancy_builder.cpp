@@ -69,9 +69,6 @@ void OccupancyBuilder::compact() {
 }
 
 OccupancyBuilder::Trees OccupancyBuilder::finish() {
-  // The maximum-likelihood tree (every node at a clamping threshold) is what map.bt stores anyway
-  // (OcTree::writeBinary), and it prunes to about half the nodes of the log-odds tree.
-  tree_->toMaxLikelihood();
   compact();
   // Each coloured (hit) voxel takes the OcTree's final occupancy there: a voxel hit once and
   // cleared by later rays is free in both trees.

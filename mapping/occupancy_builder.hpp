@@ -31,8 +31,8 @@ class OccupancyBuilder {
   // (amortised O(1) per new node, memory bounded by the pruned map).
   void insert(const CameraCloud& points_map, const Eigen::Vector3d& origin_map);
 
-  // The OcTree's maximum-likelihood form (toMaxLikelihood), updateInnerOccupancy + prune, the
-  // colour tree's occupancy from it, then hands the trees over (the builder starts afresh).
+  // updateInnerOccupancy + prune, the colour tree's occupancy from the OcTree, then hands the
+  // trees over (the builder starts afresh).
   struct Trees {
     std::unique_ptr<octomap::OcTree> occupancy;
     std::unique_ptr<octomap::ColorOcTree> color;
