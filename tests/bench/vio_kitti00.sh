@@ -76,8 +76,30 @@ for mode in modes:
     fused = rep.get("evaluation_fused", {}).get("ape_none")
     g = rep.get("gnss", {})
     if fused:
-        print(f'| {fused["rmse"]:.3f} | {g["used"]} / {g["rejected"]} '
+        online = rep["evaluation_fused"].get("ape_none_online")
+        causal = f' ({online["rmse"]:.3f} causal)' if online else ""
+        print(f'| {fused["rmse"]:.3f}{causal} | {g["used"]} / {g["rejected"]} '
               f'| {g["ms_per_fix"]["mean"]:.3f} / {g["ms_per_fix"]["p95"]:.3f} |')
     else:
         print("| - | - | - |")
+
+# The map stage (issue 8): per-keyframe cost of each stage, the build after the drive, memory.
+print()
+print("| mode | keyframes | sparse ms mean / p95 | dense depth ms mean / p95 | OctoMap ms mean / p95 "
+      "| dense + OctoMap mean (ms) | build after the drive (s) | dense points | occupied voxels "
+      "| store / OcTree (MB) | peak RSS (MB) |")
+print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+for mode in modes:
+    rep = json.load(open(os.path.join(out, mode.replace(":", "_"), "report.json")))
+    m = rep.get("map")
+    if not m:
+        print(f"| {mode} | no map | | | | | | | | | |")
+        continue
+    k = m["ms_per_keyframe"]
+    print(f'| {mode} | {m["keyframes"]} | {k["sparse"]["mean"]:.2f} / {k["sparse"]["p95"]:.2f} '
+          f'| {k["dense_depth"]["mean"]:.1f} / {k["dense_depth"]["p95"]:.1f} '
+          f'| {k["octomap"]["mean"]:.1f} / {k["octomap"]["p95"]:.1f} '
+          f'| {k["dense_depth"]["mean"] + k["octomap"]["mean"]:.1f} | {m["ms_build"] / 1e3:.1f} '
+          f'| {m["dense_points"]} | {m["occupied_voxels"]} '
+          f'| {m["store_mb"]:.0f} / {m["octree_mb"]:.0f} | {rep["peak_rss_mb"]:.0f} |')
 PY
