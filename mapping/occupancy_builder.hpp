@@ -39,9 +39,6 @@ class OccupancyBuilder {
   };
   [[nodiscard]] Trees finish();
 
-  [[nodiscard]] const octomap::OcTree& tree() const { return *tree_; }
-  [[nodiscard]] const octomap::ColorOcTree& colorTree() const { return *color_tree_; }
-
  private:
   void compact();
 

@@ -10,6 +10,7 @@
 #include "io/trajectory_io.hpp"
 #include "odometry/error.hpp"
 #include "run/gnss_run.hpp"
+#include "run/report.hpp"
 #include "run/stats.hpp"
 #include "run/vio_runner.hpp"
 
@@ -159,16 +160,7 @@ json gnssInsReport(const io::Dataset& ds, const InsRunResult& r, const InsReport
   json report;
   report["gvio_version"] = GVIO_VERSION;
   report["command_line"] = ctx.command_line;
-  report["dataset"] = {
-      {"path", ds.root.string()},
-      {"format", io::toString(ds.format)},
-      {"variant", ds.variant},
-      {"cameras", ds.cameras.size()},
-      {"frames", ds.frames.size()},
-      {"imu_samples", ds.imu.size()},
-      {"imu_rate_hz", imuRateHz(ds)},
-      {"gnss_fixes", ds.gnss.size()},
-      {"groundtruth", ds.groundtruth ? json(ds.groundtruth_source) : json(nullptr)}};
+  report["dataset"] = datasetJson(ds);
   report["mode"] = "gnss-ins";
   report["imu_noise_source"] = ctx.imu_noise_source;
   report["counts"] = {{"imu_samples", s.imu_samples},

@@ -31,20 +31,23 @@ json evaluationJson(const EvaluationOutcome& outcome) {
 
 }  // namespace
 
+json datasetJson(const io::Dataset& ds) {
+  return {{"path", ds.root.string()},
+          {"format", io::toString(ds.format)},
+          {"variant", ds.variant},
+          {"cameras", ds.cameras.size()},
+          {"frames", ds.frames.size()},
+          {"imu_samples", ds.imu.size()},
+          {"imu_rate_hz", imuRateHz(ds)},
+          {"gnss_fixes", ds.gnss.size()},
+          {"groundtruth", ds.groundtruth ? json(ds.groundtruth_source) : json(nullptr)}};
+}
+
 json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportContext& ctx) {
   json report;
   report["gvio_version"] = GVIO_VERSION;
   report["command_line"] = ctx.command_line;
-  report["dataset"] = {
-      {"path", ds.root.string()},
-      {"format", io::toString(ds.format)},
-      {"variant", ds.variant},
-      {"cameras", ds.cameras.size()},
-      {"frames", ds.frames.size()},
-      {"imu_samples", ds.imu.size()},
-      {"imu_rate_hz", imuRateHz(ds)},
-      {"gnss_fixes", ds.gnss.size()},
-      {"groundtruth", ds.groundtruth ? json(ds.groundtruth_source) : json(nullptr)}};
+  report["dataset"] = datasetJson(ds);
   report["mode"] = odometry::toString(run.mode);
   report["imu_noise_source"] =
       ctx.imu_noise_source.empty() ? json(nullptr) : json(ctx.imu_noise_source);

@@ -26,6 +26,10 @@ struct ReportContext {
   const UnalignedOutcome* evaluation_fused_online = nullptr;
 };
 
+// report.json's "dataset": path, format, variant, sensor counts, IMU rate, ground truth source
+// (shared by the VIO and the GNSS/INS reports).
+nlohmann::json datasetJson(const io::Dataset& dataset);
+
 nlohmann::json buildReport(const io::Dataset& dataset, const VioRunResult& run,
                            const ReportContext& context);
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "fusion/geodesy.hpp"
+#include "fusion/gnss_fusion.hpp"
 #include "odometry/lie.hpp"
 #include "odometry/measurements.hpp"
 #include "odometry/trajectory.hpp"
@@ -87,6 +88,28 @@ inline GnssDrive makeGnssDrive(double outage_t0_s = -1, double outage_t1_s = -1,
     d.outlier.push_back(bad);
   }
   return d;
+}
+
+// Feeds the drive to the fusion in time order (each fix before the VIO poses after it), as a run
+// does, and finishes it.
+inline void replay(fusion::GnssFusion& fusion, const GnssDrive& d) {
+  std::size_t f = 0;
+  for (std::size_t k = 0; k < d.vio.size(); ++k) {
+    while (f < d.fixes.size() && d.fixes[f].t_ns <= d.vio.t_ns[k]) fusion.addFix(d.fixes[f++]);
+    fusion.addVioPose(d.vio.t_ns[k], d.vio.poses[k]);
+  }
+  fusion.finish();
+}
+
+// Position RMSE of `est` against the truth pose with the same index, from index `from` on.
+inline double rmse(const Trajectory& truth, const Trajectory& est, std::size_t from = 0) {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = from; k < est.size(); ++k) {
+    sum += (est.poses[k].translation() - truth.poses[k].translation()).squaredNorm();
+    ++n;
+  }
+  return std::sqrt(sum / static_cast<double>(n));
 }
 
 }  // namespace gvio::test

@@ -30,24 +30,11 @@ Result fuse(const Drive& d, FusionMode mode) {
   config.mode = mode;
   config.lever_arm_b = d.lever;
   GnssFusion fusion(config, d.enu);
-  std::size_t f = 0;
-  for (std::size_t k = 0; k < d.vio.size(); ++k) {
-    while (f < d.fixes.size() && d.fixes[f].t_ns <= d.vio.t_ns[k]) fusion.addFix(d.fixes[f++]);
-    fusion.addVioPose(d.vio.t_ns[k], d.vio.poses[k]);
-  }
-  fusion.finish();
+  test::replay(fusion, d);
   return {fusion.fusedTrajectory(), fusion.stats()};
 }
 
-double rmse(const Trajectory& truth, const Trajectory& est, std::size_t from = 0) {
-  double sum = 0.0;
-  std::size_t n = 0;
-  for (std::size_t k = from; k < est.size(); ++k) {
-    sum += (est.poses[k].translation() - truth.poses[k].translation()).squaredNorm();
-    ++n;
-  }
-  return std::sqrt(sum / static_cast<double>(n));
-}
+using test::rmse;
 
 TEST(GnssFusion, GraphBeatsRawFixesAndTheKfAndRejectsOutliers) {
   const Drive d = makeDrive();

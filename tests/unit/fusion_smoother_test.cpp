@@ -26,23 +26,12 @@ Fused fuse(const test::GnssDrive& d, const SmootherConfig& smoother) {
   config.lever_arm_b = d.lever;
   config.smoother = smoother;
   GnssFusion fusion(config, d.enu);
-  std::size_t f = 0;
-  for (std::size_t k = 0; k < d.vio.size(); ++k) {
-    while (f < d.fixes.size() && d.fixes[f].t_ns <= d.vio.t_ns[k]) fusion.addFix(d.fixes[f++]);
-    fusion.addVioPose(d.vio.t_ns[k], d.vio.poses[k]);
-  }
-  fusion.finish();
+  test::replay(fusion, d);
   return {fusion.fusedTrajectory(), fusion.smoothedTrajectory(), fusion.stats(),
           fusion.smoothedCovariance()};
 }
 
-double rmse(const Trajectory& truth, const Trajectory& est) {
-  double sum = 0.0;
-  for (std::size_t k = 0; k < est.size(); ++k) {
-    sum += (est.poses[k].translation() - truth.poses[k].translation()).squaredNorm();
-  }
-  return std::sqrt(sum / static_cast<double>(est.size()));
-}
+using test::rmse;
 
 TEST(GnssSmoother, SpreadsExactNodesOverAnExactVioExactly) {
   // VIO = truth seen from a rotated, shifted world; nodes at every 7th pose hold the true pose.
@@ -114,9 +103,7 @@ TEST(GnssSmoother, IsOffInKfModeAndWhenDisabled) {
   config.mode = FusionMode::kKf;
   config.lever_arm_b = d.lever;
   GnssFusion kf(config, d.enu);
-  for (const GnssFix& f : d.fixes) kf.addFix(f);
-  for (std::size_t k = 0; k < d.vio.size(); ++k) kf.addVioPose(d.vio.t_ns[k], d.vio.poses[k]);
-  kf.finish();
+  test::replay(kf, d);
   EXPECT_FALSE(kf.fusedTrajectory().empty());
   EXPECT_TRUE(kf.smoothedTrajectory().empty());
 }

@@ -21,6 +21,7 @@
 #include "sim/kitti_convention.hpp"
 #include "sim/textures.hpp"
 #include "sim/world.hpp"
+#include "support/render_fixture.hpp"
 
 namespace gvio::sim {
 namespace {
@@ -262,16 +263,9 @@ cv::Mat greyOf(const render::ImageRgba& img) {  // grey textures: R = G = B
   return grey;
 }
 
-class SimWorldRenderTest : public ::testing::Test {
+// One EGL context and renderer for the suite (support/render_fixture.hpp).
+class SimWorldRenderTest : public test::SharedRendererTest {
  protected:
-  static void SetUpTestSuite() {
-    context_ = std::make_unique<render::EglContext>();
-    renderer_ = std::make_unique<render::Renderer>(*context_);
-  }
-  static void TearDownTestSuite() {
-    renderer_.reset();
-    context_.reset();
-  }
   cv::Mat render(const render::GpuScene& gpu, const Eigen::Isometry3d& T_w_c) const {
     const render::PinholeIntrinsics K = kittiCamera();
     render::Framebuffer fb(K.width, K.height);
@@ -297,11 +291,7 @@ class SimWorldRenderTest : public ::testing::Test {
     cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
     cv::imwrite(file, bgr);
   }
-  static std::unique_ptr<render::EglContext> context_;
-  static std::unique_ptr<render::Renderer> renderer_;
 };
-std::unique_ptr<render::EglContext> SimWorldRenderTest::context_;
-std::unique_ptr<render::Renderer> SimWorldRenderTest::renderer_;
 
 struct ViewStats {
   int corners = 0, bottom = 0, top = 0;  // all, in the bottom third, in the top half
