@@ -57,7 +57,9 @@ void KeyframeStore::setDense(std::size_t index, const CameraCloud& points_c) {
 
 void KeyframeStore::updateLandmark(std::uint64_t id, std::size_t index, const Eigen::Vector3d& p_b,
                                    int observations, double mean_reprojection_px, float intensity) {
-  StoredLandmark& lm = landmarks_[id];
+  const auto [it, inserted] = landmarks_.try_emplace(id);
+  StoredLandmark& lm = it->second;
+  if (!inserted && observations < lm.observations) return;
   lm.keyframe = index;
   lm.p_b = p_b;
   lm.observations = observations;

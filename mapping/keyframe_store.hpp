@@ -48,8 +48,11 @@ class KeyframeStore {
   // Frees keyframe `index`'s dense points (after the map has used them); it then contributes its
   // landmarks only, like a keyframe without depth.
   void releaseDense(std::size_t index);
-  // Attaches landmark `id` to keyframe `index` with its latest estimate; `intensity` < 0 keeps
-  // the previous intensity (the landmark did not project into this keyframe's image).
+  // Attaches landmark `id` to keyframe `index` with this estimate when it rests on at least as
+  // many window observations as the stored one: as frames leave the sliding window a landmark
+  // loses observations, so its last estimates (one or two frames) are its weakest and would hide
+  // how well it was once seen. `intensity` < 0 keeps the previous intensity (the landmark did
+  // not project into this keyframe's image).
   void updateLandmark(std::uint64_t id, std::size_t index, const Eigen::Vector3d& p_b,
                       int observations, double mean_reprojection_px, float intensity);
 

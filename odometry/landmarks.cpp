@@ -2,6 +2,7 @@
 
 #include <Eigen/SVD>
 #include <cmath>
+#include <limits>
 
 #include "odometry/pose_manifold.hpp"
 
@@ -127,6 +128,27 @@ void LandmarkMap::removeFrame(std::uint64_t frame_uid, const PoseLookup& poses,
     }
     ++it;
   }
+}
+
+double LandmarkMap::meanReprojectionPx(const Landmark& lm, const PoseLookup& poses,
+                                       const StereoGeometry& geometry) {
+  const double* anchor_pose = lm.has_depth ? poses(lm.anchor().frame_uid) : nullptr;
+  if (anchor_pose == nullptr) return INFINITY;
+  const Eigen::Vector3d p_w = worldPoint(lm, anchor_pose, geometry);
+  double sum = 0.0;
+  int n = 0;
+  for (const Observation& o : lm.observations) {
+    const double* pose = poses(o.frame_uid);
+    if (pose == nullptr) continue;
+    sum += reprojectionErrorPx(geometry.left, cameraInWorld(pose, geometry.left), p_w, o.px_left);
+    ++n;
+    if (o.has_right && geometry.stereo) {
+      sum +=
+          reprojectionErrorPx(geometry.right, cameraInWorld(pose, geometry.right), p_w, o.px_right);
+      ++n;
+    }
+  }
+  return n > 0 ? sum / n : std::numeric_limits<double>::infinity();
 }
 
 int LandmarkMap::rejectOutliers(const PoseLookup& poses, const StereoGeometry& geometry,

@@ -73,6 +73,11 @@ class LandmarkMap {
   // and depths out of range. Returns the number of observations removed.
   int rejectOutliers(const PoseLookup& poses, const StereoGeometry& geometry, double max_px,
                      double min_depth_m, double max_depth_m);
+  // Mean reprojection error (px) of a landmark with depth over its window observations, left and
+  // right images (a stereo match counts as a second observation); infinity when none can be
+  // projected. The map's sparse filter (mapping::SparseConfig) uses it.
+  [[nodiscard]] static double meanReprojectionPx(const Landmark& lm, const PoseLookup& poses,
+                                                 const StereoGeometry& geometry);
   // Number of landmarks with depth that are observed in frame_uid.
   [[nodiscard]] int countObservedWithDepth(std::uint64_t frame_uid) const;
   void clear() { landmarks_.clear(); }

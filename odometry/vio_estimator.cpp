@@ -304,6 +304,7 @@ std::vector<LandmarkEstimate> VioEstimator::landmarks() const {
     e.id = id;
     e.p_w = LandmarkMap::worldPoint(lm, anchor, w.geometry());
     e.observations = static_cast<int>(lm.observations.size());
+    e.mean_reprojection_px = LandmarkMap::meanReprojectionPx(lm, poses, w.geometry());
     out.push_back(e);
   }
   return out;

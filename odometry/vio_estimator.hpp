@@ -51,8 +51,8 @@ struct FrameResult {
 struct LandmarkEstimate {
   std::uint64_t id = 0;
   Eigen::Vector3d p_w = Eigen::Vector3d::Zero();
-  int observations = 0;
-  double mean_reprojection_px = 0.0;
+  int observations = 0;               // window frames that observe it
+  double mean_reprojection_px = 0.0;  // over those observations, left and right images
 };
 
 struct VioCounters {

@@ -1,0 +1,90 @@
+// The window landmarks' mean reprojection error (LandmarkMap::meanReprojectionPx), which the map's
+// sparse filter relies on: exact pixels give 0, a known pixel offset gives its share of the mean.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "odometry/landmarks.hpp"
+#include "odometry/pose_manifold.hpp"
+
+namespace gvio::odometry {
+namespace {
+
+StereoGeometry stereoRig() {
+  StereoGeometry g;
+  g.left = {500.0, 500.0, 320.0, 240.0, Eigen::Isometry3d::Identity()};
+  g.right = g.left;
+  g.right.T_b_c.translation() = Eigen::Vector3d(0.5, 0.0, 0.0);
+  g.stereo = true;
+  g.baseline_m = 0.5;
+  return g;
+}
+
+Eigen::Vector2d project(const PinholeView& view, const Eigen::Isometry3d& T_w_b,
+                        const Eigen::Vector3d& p_w) {
+  const Eigen::Vector3d p_c = (T_w_b * view.T_b_c).inverse() * p_w;
+  return {view.fx * p_c.x() / p_c.z() + view.cx, view.fy * p_c.y() / p_c.z() + view.cy};
+}
+
+class LandmarkReprojection : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    T_w_b2_.translation() = Eigen::Vector3d(1.0, 0.2, 0.5);
+    poseToBlock(Eigen::Isometry3d::Identity(), blocks_[1].data());
+    poseToBlock(T_w_b2_, blocks_[2].data());
+  }
+  [[nodiscard]] PoseLookup poses() const {
+    return [this](std::uint64_t uid) -> const double* {
+      const auto it = blocks_.find(uid);
+      return it == blocks_.end() ? nullptr : it->second.data();
+    };
+  }
+  // Landmark at p_w_ anchored in frame 1 (left only), seen in frame 2 by both cameras, the left
+  // observation moved by `offset_px`.
+  [[nodiscard]] Landmark landmark(const Eigen::Vector2d& offset_px) const {
+    Landmark lm;
+    lm.id = 7;
+    lm.inv_depth = 1.0 / p_w_.z();
+    lm.has_depth = true;
+    Observation a;
+    a.frame_uid = 1;
+    a.px_left = project(geometry_.left, Eigen::Isometry3d::Identity(), p_w_);
+    Observation b;
+    b.frame_uid = 2;
+    b.px_left = project(geometry_.left, T_w_b2_, p_w_) + offset_px;
+    b.has_right = true;
+    b.px_right = project(geometry_.right, T_w_b2_, p_w_);
+    lm.observations = {a, b};
+    return lm;
+  }
+
+  StereoGeometry geometry_ = stereoRig();
+  Eigen::Isometry3d T_w_b2_ = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d p_w_{2.0, -1.0, 12.0};
+  std::map<std::uint64_t, std::array<double, 7>> blocks_;
+};
+
+TEST_F(LandmarkReprojection, ExactObservationsGiveZero) {
+  EXPECT_NEAR(LandmarkMap::meanReprojectionPx(landmark({0.0, 0.0}), poses(), geometry_), 0.0, 1e-9);
+}
+
+TEST_F(LandmarkReprojection, OffsetCountsOverEveryImage) {
+  // Three projections (anchor left, frame 2 left and right), one 3-4-5 px off: mean 5/3 px.
+  EXPECT_NEAR(LandmarkMap::meanReprojectionPx(landmark({3.0, 4.0}), poses(), geometry_), 5.0 / 3.0,
+              1e-9);
+}
+
+TEST_F(LandmarkReprojection, NoDepthOrNoAnchorPoseIsInfinite) {
+  Landmark lm = landmark({0.0, 0.0});
+  blocks_.erase(2);
+  EXPECT_NEAR(LandmarkMap::meanReprojectionPx(lm, poses(), geometry_), 0.0, 1e-9);
+  lm.has_depth = false;
+  EXPECT_TRUE(std::isinf(LandmarkMap::meanReprojectionPx(lm, poses(), geometry_)));
+  lm.has_depth = true;
+  blocks_.erase(1);
+  EXPECT_TRUE(std::isinf(LandmarkMap::meanReprojectionPx(lm, poses(), geometry_)));
+}
+
+}  // namespace
+}  // namespace gvio::odometry
