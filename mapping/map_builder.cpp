@@ -127,26 +127,36 @@ CameraCloud MapBuilder::pointsOf(std::size_t index, const Eigen::Isometry3d& T_t
 }
 
 MapBuildResult MapBuilder::build(const PoseLookup& pose_of) const {
-  return buildImpl(pose_of, nullptr);
+  MapBuildResult result = buildClouds(pose_of);
+  MapCounts scratch;
+  occupancyInto(placedPoses(pose_of, scratch), result, nullptr);
+  return result;
 }
 
-MapBuildResult MapBuilder::buildReleasing(const PoseLookup& pose_of) {
-  return buildImpl(pose_of, &store_);
+void MapBuilder::buildOccupancyReleasing(const PoseLookup& pose_of, MapBuildResult& into) {
+  MapCounts scratch;  // the placement was counted by buildClouds
+  occupancyInto(placedPoses(pose_of, scratch), into, &store_);
 }
 
-MapBuildResult MapBuilder::buildImpl(const PoseLookup& pose_of, KeyframeStore* release) const {
+std::vector<std::optional<Eigen::Isometry3d>> MapBuilder::placedPoses(const PoseLookup& pose_of,
+                                                                      MapCounts& counts) const {
+  const auto& keyframes = store_.keyframes();
+  std::vector<std::optional<Eigen::Isometry3d>> poses(keyframes.size());
+  for (std::size_t i = 0; i < keyframes.size(); ++i) {
+    poses[i] = pose_of(keyframes[i].t_ns);
+    ++(poses[i] ? counts.keyframes_used : counts.keyframes_skipped);
+  }
+  return poses;
+}
+
+MapBuildResult MapBuilder::buildClouds(const PoseLookup& pose_of) const {
   MapBuildResult result;
   MapCounts& counts = result.counts;
   const auto& keyframes = store_.keyframes();
   counts.keyframes = keyframes.size();
   counts.landmarks_stored = store_.landmarks().size();
   counts.store_bytes = store_.memoryBytes();
-
-  std::vector<std::optional<Eigen::Isometry3d>> poses(keyframes.size());
-  for (std::size_t i = 0; i < keyframes.size(); ++i) {
-    poses[i] = pose_of(keyframes[i].t_ns);
-    ++(poses[i] ? counts.keyframes_used : counts.keyframes_skipped);
-  }
+  const auto poses = placedPoses(pose_of, counts);
 
   for (const auto& [id, lm] : store_.landmarks()) {
     if (!landmarkAccepted(lm)) {
@@ -162,36 +172,45 @@ MapBuildResult MapBuilder::buildImpl(const PoseLookup& pose_of, KeyframeStore* r
   }
   counts.sparse_points = result.sparse.size();
 
-  const auto attached = attachedLandmarks();
   DenseFusion fusion(config_.dense.voxel_size_m, config_.dense.sor_mean_k,
                      config_.dense.sor_stddev_mul);
-  OccupancyBuilder occupancy(config_.occupancy);
+  const std::vector<std::vector<std::uint64_t>> no_landmarks(keyframes.size());
   for (std::size_t i = 0; i < keyframes.size(); ++i) {
-    if (!poses[i]) continue;
-    const CameraCloud points = pointsOf(i, *poses[i], attached);
-    if (keyframes[i].has_dense) fusion.add(points);
-    const auto start = Clock::now();
-    occupancy.insert(points, *poses[i] * camera_.T_b_c.translation());
-    result.ms_octomap_per_keyframe.push_back(msSince(start));
-    if (release != nullptr && keyframes[i].has_dense) release->releaseDense(i);
+    if (poses[i] && keyframes[i].has_dense) fusion.add(pointsOf(i, *poses[i], no_landmarks));
   }
   counts.dense_points_raw = fusion.pointsAdded();
-
   const auto start = Clock::now();
   result.dense = fusion.finish();
   result.ms_dense_fusion = msSince(start);
   counts.dense_points_voxel = fusion.pointsAfterVoxel();
   counts.dense_points = result.dense.size();
+  return result;
+}
 
+void MapBuilder::occupancyInto(const std::vector<std::optional<Eigen::Isometry3d>>& poses,
+                               MapBuildResult& result, KeyframeStore* release) const {
+  const auto& keyframes = store_.keyframes();
+  const auto attached = attachedLandmarks();
+  OccupancyBuilder occupancy(config_.occupancy);
+  result.ms_octomap_per_keyframe.clear();
+  for (std::size_t i = 0; i < keyframes.size(); ++i) {
+    if (!poses[i]) continue;
+    const CameraCloud points = pointsOf(i, *poses[i], attached);
+    const auto start = Clock::now();
+    occupancy.insert(points, *poses[i] * camera_.T_b_c.translation());
+    result.ms_octomap_per_keyframe.push_back(msSince(start));
+    if (release != nullptr && keyframes[i].has_dense) release->releaseDense(i);
+  }
   auto trees = occupancy.finish();
+  MapCounts& counts = result.counts;
+  counts.occupied_leaves = 0;
+  for (auto it = trees.occupancy->begin_leafs(); it != trees.occupancy->end_leafs(); ++it) {
+    if (trees.occupancy->isNodeOccupied(*it)) ++counts.occupied_leaves;
+  }
+  counts.octree_bytes = trees.occupancy->memoryUsage();
+  counts.color_octree_bytes = trees.color->memoryUsage();
   result.occupancy = std::move(trees.occupancy);
   result.occupancy_color = std::move(trees.color);
-  for (auto it = result.occupancy->begin_leafs(); it != result.occupancy->end_leafs(); ++it) {
-    if (result.occupancy->isNodeOccupied(*it)) ++counts.occupied_leaves;
-  }
-  counts.octree_bytes = result.occupancy->memoryUsage();
-  counts.color_octree_bytes = result.occupancy_color->memoryUsage();
-  return result;
 }
 
 MapCloud MapBuilder::keyframePoints(std::int64_t t0_ns, std::int64_t t1_ns,

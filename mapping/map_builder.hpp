@@ -52,10 +52,10 @@ struct MapCounts {
 };
 
 struct MapBuildResult {
-  MapCloud sparse;  // source kSparseLandmark
-  MapCloud dense;   // source kDenseStereo
-  std::unique_ptr<octomap::OcTree> occupancy;
-  std::unique_ptr<octomap::ColorOcTree> occupancy_color;
+  MapCloud sparse;                                        // source kSparseLandmark
+  MapCloud dense;                                         // source kDenseStereo
+  std::unique_ptr<octomap::OcTree> occupancy;             // null after buildClouds alone
+  std::unique_ptr<octomap::ColorOcTree> occupancy_color;  // null after buildClouds alone
   MapCounts counts;
   std::vector<double> ms_octomap_per_keyframe;  // per used keyframe, in keyframe order
   double ms_dense_fusion = 0.0;                 // global VoxelGrid + SOR
@@ -78,10 +78,15 @@ class MapBuilder {
 
   // Rebuilds the whole map in the frame pose_of maps into.
   [[nodiscard]] MapBuildResult build(const PoseLookup& pose_of) const;
-  // The same, freeing each keyframe's dense points once they are in the map, so that the store
-  // and the map are not both held (a long drive's largest structures). Afterwards the keyframes
+
+  // The same in two stages, for a long drive (gvio run): the clouds first (sparse, dense: no
+  // trees), which the caller writes and frees, then the occupancy into the same result, freeing
+  // each keyframe's stored dense points once inserted. The dense cloud and the trees, a long
+  // drive's largest structures, are never held at once, and the trees' millions of small nodes
+  // are allocated after the dense filters' temporaries are gone. Afterwards the keyframes
   // contribute their landmarks only (keyframePoints, build).
-  [[nodiscard]] MapBuildResult buildReleasing(const PoseLookup& pose_of);
+  [[nodiscard]] MapBuildResult buildClouds(const PoseLookup& pose_of) const;
+  void buildOccupancyReleasing(const PoseLookup& pose_of, MapBuildResult& into);
 
   // Points of the keyframes with t0_ns <= t_ns <= t1_ns in the target frame, without the global
   // filters: dense points where the keyframe has them, else the landmarks attached to it that
@@ -98,8 +103,12 @@ class MapBuilder {
   [[nodiscard]] const MapConfig& config() const { return config_; }
 
  private:
+  // Each keyframe's pose in the target frame (nullopt: skipped), counted into `counts`.
+  [[nodiscard]] std::vector<std::optional<Eigen::Isometry3d>> placedPoses(const PoseLookup& pose_of,
+                                                                          MapCounts& counts) const;
   // `release`: this builder's store, to free each keyframe's dense points once used; or null.
-  [[nodiscard]] MapBuildResult buildImpl(const PoseLookup& pose_of, KeyframeStore* release) const;
+  void occupancyInto(const std::vector<std::optional<Eigen::Isometry3d>>& poses,
+                     MapBuildResult& result, KeyframeStore* release) const;
   [[nodiscard]] bool landmarkAccepted(const StoredLandmark& lm) const;
   // The points a keyframe contributes, in the target frame (see keyframePoints).
   [[nodiscard]] CameraCloud pointsOf(std::size_t index, const Eigen::Isometry3d& T_target_b,

@@ -193,11 +193,11 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
       two_pass_report = run::twoPassReport(*recorder, run::mapPoses(*recorder, fused), *two_pass,
                                            ds.frames.front().t_ns);
     }
-    run::MapRunResult map = run::buildMap(*recorder, fused);
+    const run::MapRunResult map = run::buildAndWriteMap(*recorder, fused, out);
     map_report = run::mapReport(*recorder, map);
     if (two_pass) map_report["two_pass"] = two_pass_report;
-    recorder.reset();  // the keyframe store is rebuilt into `map`: free it before writing
-    map_report["las"] = run::writeMapFiles(out, map);
+    map_report["las"] = map.las;
+    recorder.reset();
     spdlog::info("map ({}): {} landmarks, {} dense points, {} occupied voxels", map.frame,
                  map.map.counts.sparse_points, map.map.counts.dense_points,
                  map.map.counts.occupied_leaves);

@@ -54,43 +54,36 @@ class Bytes {
   std::string data_;
 };
 
+// The LAS integer grid: stored = offset + scale * steps, steps int32.
 struct Quantized {
   double scale = 0.001;
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();
-  std::vector<Eigen::Matrix<std::int32_t, 3, 1>> xyz;
-  Eigen::Vector3d min = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();
+  Eigen::Vector3d min = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();  // stored values
+
+  [[nodiscard]] Eigen::Matrix<std::int32_t, 3, 1> steps(const Eigen::Vector3d& p) const {
+    return ((p - offset) / scale).array().round().cast<std::int32_t>();
+  }
 };
 
-// Offsets at the centre of the data, rounded to whole metres, keep the 32-bit records small and
-// the stored coordinates exact multiples of the scale.
-Quantized quantize(const std::vector<Eigen::Vector3d>& utm, double scale) {
+// Offsets at the centre of the data (UTM bounds lo..hi), rounded to whole metres, keep the 32-bit
+// records small and the stored coordinates exact multiples of the scale. Rounding is monotonic,
+// so the stored bounds are the bounds' own grid values, and a grid that holds them holds every
+// point.
+Quantized quantizer(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double scale) {
   Quantized q;
   q.scale = scale;
-  if (utm.empty()) return q;
-  Eigen::Vector3d lo = utm.front(), hi = utm.front();
-  for (const auto& p : utm) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
+  if (!lo.allFinite() || !hi.allFinite()) return q;  // no point
   q.offset = (0.5 * (lo + hi)).array().round();
-  q.xyz.reserve(utm.size());
   constexpr double kMax = std::numeric_limits<std::int32_t>::max();
-  for (const auto& p : utm) {
+  for (const Eigen::Vector3d& p : {lo, hi}) {
     const Eigen::Vector3d steps = ((p - q.offset) / scale).array().round();
     if (!steps.allFinite() || steps.cwiseAbs().maxCoeff() > kMax) {
       throw InvalidInput("LAS: map spans more than the 32-bit coordinate grid holds at scale " +
                          std::to_string(scale) + " m");
     }
-    q.xyz.push_back(steps.cast<std::int32_t>());
   }
-  const auto stored = [&q](const Eigen::Matrix<std::int32_t, 3, 1>& r) -> Eigen::Vector3d {
-    return r.cast<double>() * q.scale + q.offset;
-  };
-  q.min = q.max = stored(q.xyz.front());
-  for (const auto& r : q.xyz) {
-    q.min = q.min.cwiseMin(stored(r));
-    q.max = q.max.cwiseMax(stored(r));
-  }
+  q.min = q.steps(lo).cast<double>() * scale + q.offset;
+  q.max = q.steps(hi).cast<double>() * scale + q.offset;
   return q;
 }
 
@@ -177,8 +170,8 @@ Eigen::Vector3d enuToUtm(const fusion::EnuFrame& enu, const Eigen::Vector3d& p_e
   return {utm.easting_m, northing, lla.h_ellipsoid_m};
 }
 
-LasSummary writeLas(const std::filesystem::path& file, const fusion::Lla& enu_origin,
-                    std::span<const LasPoint> points, const LasOptions& options) {
+LasSummary writeLas(const std::filesystem::path& file, const fusion::Lla& enu_origin, std::size_t n,
+                    const LasPointAt& point_at, const LasOptions& options) {
   if (!(options.scale_m > 0.0)) throw InvalidInput("LAS: scale must be positive");
   LasSummary summary;
   summary.crs = options.utm_zone ? fusion::llaToUtm(enu_origin, *options.utm_zone)
@@ -187,23 +180,35 @@ LasSummary writeLas(const std::filesystem::path& file, const fusion::Lla& enu_or
   const std::string wkt = wktFromEpsg(summary.crs.epsg());
 
   const fusion::EnuFrame enu(enu_origin);
-  std::vector<Eigen::Vector3d> utm;
-  utm.reserve(points.size());
-  for (const LasPoint& p : points) {
-    utm.push_back(enuToUtm(enu, p.p_enu, summary.crs.zone, summary.crs.north));
+  const auto utm = [&](const LasPoint& p) {
+    return enuToUtm(enu, p.p_enu, summary.crs.zone, summary.crs.north);
+  };
+  // Pass 1: the bounds.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::optional<LasPoint> p = point_at(k);
+    if (!p) continue;
+    const Eigen::Vector3d u = utm(*p);
+    if (!u.allFinite()) throw InvalidInput("LAS: a point has a non-finite coordinate");
+    lo = lo.cwiseMin(u);
+    hi = hi.cwiseMax(u);
+    ++summary.points;
   }
-  const Quantized q = quantize(utm, options.scale_m);
-  summary.points = points.size();
+  const Quantized q = quantizer(lo, hi, options.scale_m);
   summary.min = q.min;
   summary.max = q.max;
 
+  // Pass 2: the records, in chunks of about 1 MB.
   const std::string vlr = wktVlr(wkt);
   const auto offset_to_points = static_cast<std::uint32_t>(kHeaderSize + vlr.size());
   io::writeFileAtomic(file, [&](std::ostream& out) {
     out << header(q, summary.points, offset_to_points) << vlr;
     Bytes chunk;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      putPoint(chunk, q.xyz[i], points[i]);
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::optional<LasPoint> p = point_at(k);
+      if (!p) continue;
+      putPoint(chunk, q.steps(utm(*p)), *p);
       if (chunk.data().size() >= (1u << 20)) {
         out << chunk.data();
         chunk.clear();
@@ -212,6 +217,13 @@ LasSummary writeLas(const std::filesystem::path& file, const fusion::Lla& enu_or
     out << chunk.data();
   });
   return summary;
+}
+
+LasSummary writeLas(const std::filesystem::path& file, const fusion::Lla& enu_origin,
+                    std::span<const LasPoint> points, const LasOptions& options) {
+  return writeLas(
+      file, enu_origin, points.size(),
+      [points](std::size_t k) { return std::optional<LasPoint>(points[k]); }, options);
 }
 
 }  // namespace gvio::exporter

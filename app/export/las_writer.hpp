@@ -4,8 +4,10 @@
 // library writes LAS: liblas and PDAL are not packaged for bookworm, and GDAL 3.6 has no LAS
 // driver. Coordinates are UTM easting/northing (one zone for the whole file, the zone of the ENU
 // origin unless forced) and WGS 84 ellipsoidal height, in metres.
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <span>
 
@@ -38,9 +40,17 @@ struct LasSummary {
 Eigen::Vector3d enuToUtm(const fusion::EnuFrame& enu, const Eigen::Vector3d& p_enu, int zone,
                          bool north);
 
-// Writes `points` (local ENU at `enu_origin`) to `file` atomically. Throws InvalidInput when a
-// coordinate does not fit the 32-bit integer grid or the origin is outside UTM's latitude band,
-// InputError (naming `file`) when it cannot be written.
+// Point k (0 <= k < n) of a cloud, or nullopt for one the file leaves out: lets a large cloud be
+// written without a copy of it (KITTI-00's 14 M-point map). Called twice per point.
+using LasPointAt = std::function<std::optional<LasPoint>(std::size_t k)>;
+
+// Writes the points (local ENU at `enu_origin`) to `file` atomically, streaming: a first pass
+// finds the bounds (header, offsets), the second writes the records, so nothing per point is
+// held. Throws InvalidInput when a coordinate does not fit the 32-bit integer grid (before
+// anything is written) or the origin is outside UTM's latitude band, InputError (naming `file`)
+// when it cannot be written.
+LasSummary writeLas(const std::filesystem::path& file, const fusion::Lla& enu_origin, std::size_t n,
+                    const LasPointAt& point_at, const LasOptions& options = {});
 LasSummary writeLas(const std::filesystem::path& file, const fusion::Lla& enu_origin,
                     std::span<const LasPoint> points, const LasOptions& options = {});
 

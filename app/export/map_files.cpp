@@ -188,48 +188,50 @@ void writePly(const fs::path& file, const pcl::PCLPointCloud2& cloud) {
   io::moveIntoPlace(tmp, file);
 }
 
-std::vector<LasPoint> lasPoints(const pcl::PCLPointCloud2& cloud) {
+LasPointAt lasPointSource(const pcl::PCLPointCloud2& cloud) {
   const pcl::PCLPointField* fx = findField(cloud, "x");
   const pcl::PCLPointField* fy = findField(cloud, "y");
   const pcl::PCLPointField* fz = findField(cloud, "z");
   const pcl::PCLPointField* fi = findField(cloud, "intensity");
-  if (fx == nullptr || fy == nullptr || fz == nullptr) return {};
-  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
-  auto at = [&](std::size_t k, const pcl::PCLPointField& f) {
+  if (fx == nullptr || fy == nullptr || fz == nullptr) {
+    return [](std::size_t) { return std::optional<LasPoint>(); };
+  }
+  auto at = [&cloud](std::size_t k, const pcl::PCLPointField& f) {
     const std::size_t row = k / cloud.width, col = k % cloud.width;
     return fieldValue(&cloud.data[row * cloud.row_step + col * cloud.point_step + f.offset],
                       f.datatype);
   };
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
   double max_intensity = 0.0;
   if (fi != nullptr) {
     for (std::size_t k = 0; k < n; ++k) max_intensity = std::max(max_intensity, at(k, *fi));
   }
   const double scale = fi != nullptr ? intensityScale(*fi, max_intensity) : 0.0;
-  std::vector<LasPoint> points;
-  points.reserve(n);
-  for (std::size_t k = 0; k < n; ++k) {
+  return [=](std::size_t k) -> std::optional<LasPoint> {
     LasPoint p;
     p.p_enu = {at(k, *fx), at(k, *fy), at(k, *fz)};
-    if (!p.p_enu.allFinite()) continue;  // PCL marks invalid points with NaN
+    if (!p.p_enu.allFinite()) return std::nullopt;  // PCL marks invalid points with NaN
     if (fi != nullptr) {
       const double v = at(k, *fi) * scale;
       p.intensity = std::isfinite(v)
                         ? static_cast<std::uint16_t>(std::clamp(std::round(v), 0.0, 65535.0))
                         : 0;
     }
-    points.push_back(p);
-  }
-  return points;
+    return p;
+  };
 }
 
 LasSummary writeMapLas(const fs::path& file, const pcl::PCLPointCloud2& cloud, const Georef& georef,
                        const fs::path& source) {
-  const std::vector<LasPoint> points = lasPoints(cloud);
-  if (points.empty()) throw io::InputError(source, 0, "map is empty (0 finite points)");
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  const LasPointAt point_at = lasPointSource(cloud);
+  std::size_t first = 0;
+  while (first < n && !point_at(first)) ++first;
+  if (first == n) throw io::InputError(source, 0, "map is empty (0 finite points)");
   LasOptions options;
   options.utm_zone = georef.utm_zone;
   options.utm_north = georef.utm_north;
-  return writeLas(file, georef.enu_origin, points, options);
+  return writeLas(file, georef.enu_origin, n, point_at, options);
 }
 
 OctreeSummary copyOctreeBinary(const fs::path& in, const fs::path& out) {

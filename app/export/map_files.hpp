@@ -22,10 +22,12 @@ pcl::PCLPointCloud2 readPointCloud2(const std::filesystem::path& file);
 void writePcd(const std::filesystem::path& file, const pcl::PCLPointCloud2& cloud);
 void writePly(const std::filesystem::path& file, const pcl::PCLPointCloud2& cloud);
 
-// The cloud's finite x/y/z (ENU) with its "intensity" field, when present, scaled to LAS's 16-bit
-// range by the field's type: 8-bit x 257, 16-bit as is, floats in [0, 1] x 65535, floats up to
-// 255 x 257, anything else clamped.
-std::vector<LasPoint> lasPoints(const pcl::PCLPointCloud2& cloud);
+// The cloud's points for the LAS writer, read from the cloud in place (it must outlive the
+// result): x/y/z (ENU), nullopt where not finite (PCL's invalid points) or when the cloud has no
+// x/y/z fields, with the "intensity" field, when present, scaled to LAS's 16-bit range by the
+// field's type: 8-bit x 257, 16-bit as is, floats in [0, 1] x 65535, floats up to 255 x 257,
+// anything else clamped. Point count: width x height.
+LasPointAt lasPointSource(const pcl::PCLPointCloud2& cloud);
 
 // A map cloud (local ENU at georef's origin) as LAS 1.4 in georef's UTM zone, atomically: what
 // `gvio export --to las` and gvio run's map.las write. Throws InputError naming `source` (the

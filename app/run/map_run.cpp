@@ -83,16 +83,6 @@ mapping::PoseLookup mapPoses(const MapRecorder& recorder, const Trajectory* fuse
   return [fused](std::int64_t t_ns) { return fusion::interpolatePose(*fused, t_ns); };
 }
 
-MapRunResult buildMap(MapRecorder& recorder, const Trajectory* fused) {
-  const auto start = std::chrono::steady_clock::now();
-  MapRunResult r;
-  r.frame = fused != nullptr && !fused->empty() ? "enu" : "vio_world";
-  r.map = recorder.buildReleasing(mapPoses(recorder, fused));
-  r.build_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  return r;
-}
-
 namespace {
 
 // map.las from the map's blob when the run is georeferenced, else the reason (and no stale file).
@@ -120,22 +110,44 @@ nlohmann::json writeLasOrSayWhy(const std::filesystem::path& out, const std::str
                               s.crs.zone, s.crs.north ? "N" : "S")}};
 }
 
-}  // namespace
-
-nlohmann::json writeMapFiles(const std::filesystem::path& out, MapRunResult& r) {
-  // Largest first out of memory: the trees are written and freed before the cloud is converted.
-  if (r.map.occupancy) writeTreeAtomic(out / "map.bt", *r.map.occupancy, true);
-  r.map.occupancy.reset();
-  if (r.map.occupancy_color) writeTreeAtomic(out / "map.ot", *r.map.occupancy_color, false);
-  r.map.occupancy_color.reset();
+// map.pcd, map.ply and map.las from the map's clouds, which are freed; report.json's "las".
+nlohmann::json writeCloudFiles(const std::filesystem::path& out, MapRunResult& r) {
   if (r.map.sparse.empty() && r.map.dense.empty()) {
-    spdlog::warn("the map is empty (no keyframe had landmarks or depth): no map files written");
+    spdlog::warn("the map is empty (no keyframe had landmarks or depth): no cloud files written");
     return writeLasOrSayWhy(out, r.frame, nullptr);
   }
   const pcl::PCLPointCloud2 blob = mapBlob(r.map.sparse, r.map.dense);
+  mapping::MapCloud().swap(r.map.sparse);
   exporter::writePcd(out / "map.pcd", blob);
   exporter::writePly(out / "map.ply", blob);
   return writeLasOrSayWhy(out, r.frame, &blob);
+}
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+MapRunResult buildAndWriteMap(MapRecorder& recorder, const Trajectory* fused,
+                              const std::filesystem::path& out) {
+  MapRunResult r;
+  r.frame = fused != nullptr && !fused->empty() ? "enu" : "vio_world";
+  const mapping::PoseLookup poses = mapPoses(recorder, fused);
+  auto start = std::chrono::steady_clock::now();
+  r.map = recorder.buildClouds(poses);
+  r.build_ms = msSince(start);
+  r.las = writeCloudFiles(out, r);
+
+  start = std::chrono::steady_clock::now();
+  recorder.buildOccupancyReleasing(poses, r.map);
+  r.build_ms += msSince(start);
+  writeTreeAtomic(out / "map.bt", *r.map.occupancy, true);
+  r.map.occupancy.reset();
+  writeTreeAtomic(out / "map.ot", *r.map.occupancy_color, false);
+  r.map.occupancy_color.reset();
+  return r;
 }
 
 nlohmann::json mapReport(const MapRecorder& recorder, const MapRunResult& r) {

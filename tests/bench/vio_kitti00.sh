@@ -54,7 +54,7 @@ python3 - "$OUT" $MODES <<'PY'
 import json, os, sys
 out, modes = sys.argv[1], sys.argv[2:]
 print("| mode | poses | VIO APE RMSE (m) | VIO RPE per 100 m (mean %, rmse %) | tracking ms mean / p95 "
-      "| estimator ms mean / p95 | tracking + estimator mean (ms) | peak RSS (MB) "
+      "| estimator ms mean / p95 | tracking + estimator mean (ms) | peak RSS (MiB) "
       "| fused APE RMSE, no alignment (m) | GNSS used / rejected | ms per fix mean / p95 |")
 print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
 for mode in modes:
@@ -87,7 +87,7 @@ for mode in modes:
 print()
 print("| mode | keyframes | sparse ms mean / p95 | dense depth ms mean / p95 | OctoMap ms mean / p95 "
       "| dense + OctoMap mean (ms) | build after the drive (s) | dense points | occupied voxels "
-      "| store / OcTree (MB) | peak RSS (MB) |")
+      "| store / OcTree (MB) | peak RSS (MiB) |")
 print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
 for mode in modes:
     rep = json.load(open(os.path.join(out, mode.replace(":", "_"), "report.json")))

@@ -91,6 +91,29 @@ TEST(MappingBuilder, LandmarksFollowTheCorrectedKeyframePose) {
   EXPECT_EQ(fused.counts.keyframes_skipped, 0u);
 }
 
+TEST(MappingBuilder, LandmarkKeepsItsBestSupportedEstimate) {
+  // As frames leave the window a landmark loses observations: the estimate that rested on the
+  // most observations stays, with its keyframe; more observations later replace it.
+  MapBuilder builder(sparseOnly(), camera(), 0.0);
+  const Eigen::Isometry3d T1 = pose(0.1, {0.0, 0.0, 0.0}), T2 = pose(0.2, {5.0, 0.0, 0.0});
+  const Eigen::Vector3d best_w(20.0, 2.0, 1.5), late_w(20.4, 2.3, 1.4);
+  builder.addKeyframe(1000, T1, cv::Mat(), cv::Mat(), {landmark(1, best_w, 8, 0.6)});
+  builder.addKeyframe(2000, T2, cv::Mat(), cv::Mat(),
+                      {landmark(1, late_w, 2, 0.2), landmark(2, late_w, 3, 0.3)});
+  builder.addKeyframe(3000, T2, cv::Mat(), cv::Mat(), {landmark(2, best_w, 5, 0.4)});
+  const auto& lms = builder.store().landmarks();
+  EXPECT_EQ(lms.at(1).keyframe, 0u);
+  EXPECT_EQ(lms.at(1).observations, 8);
+  EXPECT_DOUBLE_EQ(lms.at(1).mean_reprojection_px, 0.6);
+  EXPECT_EQ(lms.at(2).keyframe, 2u);
+  EXPECT_EQ(lms.at(2).observations, 5);
+  const MapBuildResult map = builder.build(builder.vioPoses());
+  ASSERT_EQ(map.sparse.size(), 2u);
+  const auto points = byObservations(map.sparse);
+  EXPECT_LT((points.at(8) - best_w).norm(), 1e-5);
+  EXPECT_LT((points.at(5) - best_w).norm(), 1e-5);
+}
+
 TEST(MappingBuilder, SparseFiltersOnObservationsAndReprojection) {
   MapConfig config = sparseOnly();  // defaults: >= 4 observations, <= 1.5 px
   MapBuilder builder(config, camera(), 0.0);
@@ -214,10 +237,19 @@ TEST(MappingBuilder, DenseCloudIsVoxelDownsampledAndFollowsPoses) {
   // Occupancy from dense keyframes: the plane is occupied.
   EXPECT_GT(map.counts.occupied_leaves, 1000u);
 
-  // Building while freeing the stored points gives the same map and leaves no dense point.
-  const MapBuildResult released = builder.buildReleasing(builder.vioPoses());
-  EXPECT_EQ(released.dense.size(), map.dense.size());
-  EXPECT_EQ(released.counts.occupied_leaves, map.counts.occupied_leaves);
+  // Built in two stages, freeing the stored points: the same map, no dense point left. The
+  // clouds come without trees; the occupancy stage adds them.
+  MapBuildResult staged = builder.buildClouds(builder.vioPoses());
+  EXPECT_FALSE(staged.occupancy || staged.occupancy_color);
+  EXPECT_EQ(staged.dense.size(), map.dense.size());
+  EXPECT_EQ(staged.counts.dense_points_raw, map.counts.dense_points_raw);
+  EXPECT_EQ(staged.counts.keyframes_used, 2u);
+  builder.buildOccupancyReleasing(builder.vioPoses(), staged);
+  ASSERT_TRUE(staged.occupancy && staged.occupancy_color);
+  EXPECT_EQ(staged.occupancy->getNumLeafNodes(), map.occupancy->getNumLeafNodes());
+  EXPECT_EQ(staged.counts.occupied_leaves, map.counts.occupied_leaves);
+  EXPECT_EQ(staged.counts.keyframes_used, 2u);
+  EXPECT_EQ(staged.ms_octomap_per_keyframe.size(), 2u);
   EXPECT_EQ(builder.store().densePointCount(), 0u);
   EXPECT_TRUE(builder.keyframePoints(1, 2, builder.vioPoses()).empty());
 }
