@@ -59,6 +59,10 @@ void InsConfig::validate() const {
     throw InvalidInput("config: fusion.ins.velocity_min_speed_mps must be >= 0");
   }
   requirePositive(velocity_gate_chi2, "fusion.ins.velocity_gate_chi2");
+  requirePositive(nhc_sigma_mps, "fusion.ins.nhc_sigma_mps");
+  if (!mount_rpy_deg.allFinite() || mount_rpy_deg.cwiseAbs().maxCoeff() > 180.0) {
+    throw InvalidInput("config: fusion.ins.mount_rpy_deg must be three angles within +-180 deg");
+  }
   requirePositive(init_window_s, "fusion.ins.init_window_s");
   requirePositive(init_min_speed_mps, "fusion.ins.init_min_speed_mps");
   requirePositive(init_tilt_sigma_deg, "fusion.ins.init_tilt_sigma_deg");
@@ -79,6 +83,11 @@ std::optional<Eigen::Vector2d> fixVelocityEn(const GnssFix& fix) {
 
 GnssIns::GnssIns(const InsConfig& config, const EnuFrame& enu) : config_(config), enu_(enu) {
   config_.validate();
+  const Eigen::Vector3d rpy = config_.mount_rpy_deg * kDegToRad;
+  R_v_b_ = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+            Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+            Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+               .toRotationMatrix();
   x_.time_offset_s = config_.receiver_time_offset_s;
 }
 
@@ -126,6 +135,7 @@ void GnssIns::addFix(const GnssFix& fix) {
   } else {
     updatePosition(fix, p_ant);
     if (config_.use_velocity) updateVelocity(fix);
+    if (config_.use_nhc) updateNonHolonomic();
   }
   prev_fix_ = std::make_pair(fix.t_ns, p_ant);
   stats_.ms_per_fix.push_back(
@@ -262,6 +272,18 @@ void GnssIns::updateVelocity(const GnssFix& fix) {
     ++stats_.velocity_used;
   } else {
     ++stats_.velocity_rejected;
+  }
+}
+
+void GnssIns::updateNonHolonomic() {
+  const Eigen::Matrix2d R =
+      config_.nhc_sigma_mps * config_.nhc_sigma_mps * Eigen::Matrix2d::Identity();
+  const InsMeasurement<2> m = vehicleLateralVerticalVelocity(x_, R_v_b_);
+  stats_.nhc_innovation_sum_mps -= m.h;
+  if (update<2>(m, Eigen::Vector2d::Zero(), R, config_.velocity_gate_chi2, false)) {
+    ++stats_.nhc_used;
+  } else {
+    ++stats_.nhc_rejected;
   }
 }
 

@@ -44,7 +44,16 @@ struct InsConfig {
   double velocity_sigma_mps = 0.2;        // 1-sigma per horizontal axis of that velocity
   double velocity_min_speed_mps = 2.0;    // below this the course is not used
   double velocity_gate_chi2 = 13.82;      // velocity innovation gate (2 dof, 99.9 %)
-  double init_window_s = 1.0;             // IMU samples averaged for roll / pitch
+  // Non-holonomic constraint (a car moves along its forward axis), applied at each fix: the
+  // vehicle's lateral and vertical velocity 0 with this 1-sigma (it also absorbs the IMU's offset
+  // from the rear axle in turns). Gated like the velocity. The vehicle frame (forward-left-up) is
+  // the IMU body frame turned by the mounting angles: roll, pitch, yaw of the IMU in the vehicle,
+  // R_v_b = Rz(yaw) Ry(pitch) Rx(roll); a tilt left unconfigured biases the constraint by
+  // speed x tilt.
+  bool use_nhc = true;
+  double nhc_sigma_mps = 0.3;
+  Eigen::Vector3d mount_rpy_deg = Eigen::Vector3d::Zero();
+  double init_window_s = 1.0;           // IMU samples averaged for roll / pitch
   double init_min_speed_mps = 3.0;      // GNSS speed at which the heading is taken from the course
   double init_tilt_sigma_deg = 2.0;     // initial roll / pitch 1-sigma
   double init_heading_sigma_deg = 5.0;  // initial heading 1-sigma
@@ -74,6 +83,11 @@ struct InsStats {
   int fixes_before_init = 0;  // waiting for motion (heading) and the IMU window
   int velocity_used = 0;
   int velocity_rejected = 0;
+  int nhc_used = 0;
+  int nhc_rejected = 0;
+  // Sum of the constraint's innovations (vehicle lateral, vertical velocity before each update):
+  // a mean far from 0 says the vehicle frame is wrong (an unconfigured IMU tilt).
+  Eigen::Vector2d nhc_innovation_sum_mps = Eigen::Vector2d::Zero();
   std::optional<std::int64_t> t_init_ns;
   std::vector<std::pair<std::int64_t, std::int64_t>> outages;  // [t0, t1] without accepted fixes
   std::vector<double> ms_per_fix;                              // update cost of each fix
@@ -107,6 +121,7 @@ class GnssIns {
   void tryInitialize(const GnssFix& fix, const Eigen::Vector3d& p_ant_enu);
   void updatePosition(const GnssFix& fix, const Eigen::Vector3d& p_ant_enu);
   void updateVelocity(const GnssFix& fix);
+  void updateNonHolonomic();
   // Kalman update with gating; returns true when applied.
   template <int Rows>
   bool update(const InsMeasurement<Rows>& m, const Eigen::Matrix<double, Rows, 1>& z,
@@ -116,6 +131,7 @@ class GnssIns {
 
   InsConfig config_;
   EnuFrame enu_;
+  Eigen::Matrix3d R_v_b_ = Eigen::Matrix3d::Identity();  // from mount_rpy_deg
   bool initialized_ = false;
   InsState x_;
   InsMatrix P_ = InsMatrix::Zero();

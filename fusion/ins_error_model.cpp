@@ -129,4 +129,16 @@ InsMeasurement<2> antennaVelocityEn(const InsState& x, const Eigen::Vector3d& ac
   return m;
 }
 
+InsMeasurement<2> vehicleLateralVerticalVelocity(const InsState& x, const Eigen::Matrix3d& R_v_b) {
+  // R = R_hat Exp(dtheta): R^T v = (I - [dtheta]x) R_hat^T v = R_hat^T v + [R_hat^T v]x dtheta.
+  const Eigen::Vector3d v_b = x.R_enu_b.transpose() * x.v_enu_mps;
+  Eigen::Matrix<double, 3, kInsDim> H3 = Eigen::Matrix<double, 3, kInsDim>::Zero();
+  H3.block<3, 3>(0, kInsV) = R_v_b * x.R_enu_b.transpose();
+  H3.block<3, 3>(0, kInsTheta) = R_v_b * hat(v_b);
+  InsMeasurement<2> m;
+  m.h = (R_v_b * v_b).tail<2>();
+  m.H = H3.bottomRows<2>();
+  return m;
+}
+
 }  // namespace gvio::fusion

@@ -75,4 +75,10 @@ InsMeasurement<2> antennaVelocityEn(const InsState& x, const Eigen::Vector3d& ac
                                     const Eigen::Vector3d& lever_arm_b,
                                     double stamp_minus_filter_s);
 
+// Non-holonomic constraint of a land vehicle (Groves section 14.3.3 "motion constraints"; Shin
+// 2001): a car moves along its forward axis, so its lateral and vertical velocities are near
+// zero. h = [e_y e_z]^T R_v_b R^T v, the velocity in the vehicle frame (forward-left-up; R_v_b:
+// IMU body -> vehicle, the mounting rotation), measured as 0.
+InsMeasurement<2> vehicleLateralVerticalVelocity(const InsState& x, const Eigen::Matrix3d& R_v_b);
+
 }  // namespace gvio::fusion
