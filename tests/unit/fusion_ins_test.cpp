@@ -347,14 +347,25 @@ TEST(GnssIns, ReconvergesAfterBoundedRejections) {
 }
 
 TEST(GnssIns, ConfigValidationNamesTheKey) {
+  const auto expectNamed = [](const InsConfig& c, const std::string& key) {
+    try {
+      c.validate();
+      ADD_FAILURE() << "expected InvalidInput for " << key;
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  };
   InsConfig c;
   c.velocity_sigma_mps = 0.0;
-  try {
-    c.validate();
-    FAIL() << "expected InvalidInput";
-  } catch (const InvalidInput& e) {
-    EXPECT_NE(std::string(e.what()).find("fusion.ins.velocity_sigma_mps"), std::string::npos);
-  }
+  expectNamed(c, "fusion.ins.velocity_sigma_mps");
+  c = InsConfig{};
+  c.nhc_sigma_mps = -0.1;
+  expectNamed(c, "fusion.ins.nhc_sigma_mps");
+  c = InsConfig{};
+  c.mount_rpy_deg.y() = std::nan("");
+  expectNamed(c, "fusion.ins.mount_rpy_deg");
+  c.mount_rpy_deg = {0.0, 0.0, 270.0};
+  expectNamed(c, "fusion.ins.mount_rpy_deg");
 }
 
 }  // namespace
