@@ -57,6 +57,10 @@ struct CommandResult {
   int exit_code = -1;
   std::string out, err;
 };
+// A path single-quoted for the shell command runGvio builds (test paths hold no single quote).
+inline std::string quoted(const std::filesystem::path& p) {
+  return "'" + p.string() + "'";
+}
 // Runs the built gvio binary with `args` (shell-quoted by the caller), capturing stdout/stderr.
 CommandResult runGvio(const std::string& args);
 // The output folder of `gvio simulate <args> --out <folder>`, simulated once per build of the gvio

@@ -15,11 +15,8 @@ namespace gvio {
 namespace {
 
 namespace fs = std::filesystem;
+using test::quoted;
 using ::testing::HasSubstr;
-
-std::string quoted(const fs::path& p) {
-  return "'" + p.string() + "'";
-}
 
 // `gvio inspect --dataset <dataset> --no-progress <extra>`.
 test::CommandResult inspect(const fs::path& dataset, const std::string& extra = "") {

@@ -47,10 +47,6 @@ Trajectory loopDrive() {
   return t;
 }
 
-std::string quoted(const fs::path& p) {
-  return "'" + p.string() + "'";
-}
-
 TEST(CliMapLoop, TwoPassesOverTheSamePlaceAgreeWithinHalfAMetreMedian) {
   TempDir tmp("cli_map_loop");
   io::writeTum(tmp.path() / "loop.tum", loopDrive());

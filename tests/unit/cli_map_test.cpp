@@ -25,10 +25,6 @@ namespace gvio::test {
 namespace {
 namespace fs = std::filesystem;
 
-std::string quoted(const fs::path& p) {
-  return "'" + p.string() + "'";
-}
-
 class CliMap : public ::testing::Test {
  protected:
   // One 20 s drive and one run shared by the tests (the run takes ~20 s).

@@ -24,10 +24,6 @@ namespace fs = std::filesystem;
 using odometry::VioMode;
 using testing::HasSubstr;
 
-std::string quoted(const fs::path& p) {
-  return "'" + p.string() + "'";
-}
-
 CommandResult runOn(const fs::path& dataset, const fs::path& out, const std::string& extra = "") {
   return runGvio(fmt::format("run --dataset {} --out {} --no-progress {}", quoted(dataset),
                              quoted(out), extra));
