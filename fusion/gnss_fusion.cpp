@@ -207,7 +207,8 @@ bool GnssFusion::Impl::fuseGraph(const Pair& pair) {
   // Gate: the fix against the antenna predicted by the VIO motion since the newest node. The node
   // is itself uncertain by up to about one fix's sigma (it rests on a few fixes seen through the
   // VIO), hence twice the fix variance plus the VIO drift since the node.
-  const double sigma_motion = config.vio_drift_fraction * dist + config.vio_sigma_floor_m;
+  const RelativeNoise noise = config.relativeNoise();
+  const double sigma_motion = noise.positionSigmaM(dist);
   const double var_pred = sigma_motion * sigma_motion + config.gate_floor_m * config.gate_floor_m;
   const Eigen::Vector3d innovation = pair.p_enu - T_pred * lever;
   const double var_h = 2.0 * pair.fix.sigma_h_m * pair.fix.sigma_h_m + var_pred;
@@ -217,9 +218,8 @@ bool GnssFusion::Impl::fuseGraph(const Pair& pair) {
   if (chi2 > config.gate_chi2 && consecutive_rejections < config.max_consecutive_rejections) {
     return false;
   }
-  auto relative = std::make_shared<RelativePoseFactor>(
-      T_rel, config.vio_rot_drift_rad_per_m * dist + config.vio_rot_floor_rad,
-      config.vio_drift_fraction * dist + config.vio_sigma_floor_m);
+  auto relative = std::make_shared<RelativePoseFactor>(T_rel, noise.rotationSigmaRad(dist),
+                                                       noise.positionSigmaM(dist));
   GraphNode& n = graph.addNode(pair.t_ns, T_pred, pair.T_w_b, relative);
   graph.addGnssFactor(n, std::make_shared<GnssPositionFactor>(lever, pair.p_enu, pair.fix.sigma_h_m,
                                                               pair.fix.sigma_v_m));
@@ -238,8 +238,7 @@ void GnssFusion::Impl::smooth() {
     return;
   }
   const auto start = Clock::now();
-  const RelativeNoise noise{config.vio_drift_fraction, config.vio_sigma_floor_m,
-                            config.vio_rot_drift_rad_per_m, config.vio_rot_floor_rad};
+  const RelativeNoise noise = config.relativeNoise();
   const SmoothedNodes nodes =
       smoothNodes(graph_fixes, config.lever_arm_b, noise, config.huber_sigmas, config.smoother);
   smoothed = spreadOverVio(vio, graph_fixes, nodes, noise, &smoothed_covariance);

@@ -56,6 +56,10 @@ struct FusionConfig {
   KfConfig kf;
   SmootherConfig smoother;  // graph mode: the offline pass after the drive
   void validate() const;    // throws InvalidInput naming the field
+  // The vio_* fields as the VIO relative-motion noise model of the graph and the smoother.
+  [[nodiscard]] RelativeNoise relativeNoise() const {
+    return {vio_drift_fraction, vio_sigma_floor_m, vio_rot_drift_rad_per_m, vio_rot_floor_rad};
+  }
 };
 
 // What became of one screened fix.

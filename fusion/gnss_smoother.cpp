@@ -91,8 +91,7 @@ SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Ve
     const Eigen::Isometry3d T_rel = fixes[k - 1].T_w_b.inverse() * f.T_w_b;
     const double dist = T_rel.translation().norm();
     problem.AddResidualBlock(
-        new RelativePoseFactor(T_rel, noise.rot_drift_rad_per_m * dist + noise.rot_floor_rad,
-                               noise.drift_fraction * dist + noise.sigma_floor_m),
+        new RelativePoseFactor(T_rel, noise.rotationSigmaRad(dist), noise.positionSigmaM(dist)),
         nullptr, poses[k - 1].data(), poses[k].data());
     if (with_bias) {
       const double dt = static_cast<double>(f.t_ns - fixes[k - 1].t_ns) * 1e-9;
@@ -134,8 +133,8 @@ Trajectory spreadOverVio(const Trajectory& vio, const std::vector<SmootherFix>& 
   // The VIO's drift between a node and the pose, as the relative factors model it.
   const auto drift = [&](std::size_t j, std::size_t k) {
     const double d = (nodes[j].T_w_b.translation() - vio.poses[k].translation()).norm();
-    const double s_rot = noise.rot_drift_rad_per_m * d + noise.rot_floor_rad;
-    const double s_pos = noise.drift_fraction * d + noise.sigma_floor_m;
+    const double s_rot = noise.rotationSigmaRad(d);
+    const double s_pos = noise.positionSigmaM(d);
     PoseCovariance q = PoseCovariance::Zero();
     q.diagonal() << s_rot * s_rot, s_rot * s_rot, s_rot * s_rot, s_pos * s_pos, s_pos * s_pos,
         s_pos * s_pos;

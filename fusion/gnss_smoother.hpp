@@ -47,6 +47,13 @@ struct RelativeNoise {
   double sigma_floor_m = 0.02;
   double rot_drift_rad_per_m = 1e-5;
   double rot_floor_rad = 5e-4;
+
+  [[nodiscard]] double positionSigmaM(double distance_m) const {
+    return drift_fraction * distance_m + sigma_floor_m;
+  }
+  [[nodiscard]] double rotationSigmaRad(double distance_m) const {
+    return rot_drift_rad_per_m * distance_m + rot_floor_rad;
+  }
 };
 
 // Covariance of a pose in ENU-aligned axes: (rotation about E, N, U (rad); position E, N, U (m)),
