@@ -68,12 +68,11 @@ Trajectory reexpressEnu(const Trajectory& poses, const fusion::Lla& from, const 
 
 namespace {
 
-// The non-holonomic constraint's mean innovation (vehicle lateral, vertical), m/s; null unused.
-json nhcMeanInnovation(const fusion::InsStats& s) {
+// The non-holonomic constraint's mean innovation (vehicle lateral, vertical), m/s; none unused.
+std::optional<Eigen::Vector2d> nhcMeanInnovation(const fusion::InsStats& s) {
   const int n = s.nhc_used + s.nhc_rejected;
-  if (n == 0) return nullptr;
-  const Eigen::Vector2d mean = s.nhc_innovation_sum_mps / n;
-  return {mean.x(), mean.y()};
+  if (n == 0) return std::nullopt;
+  return Eigen::Vector2d(s.nhc_innovation_sum_mps / n);
 }
 
 // Above this mean innovation the vehicle frame is probably wrong. The filter partly bends its
@@ -115,14 +114,13 @@ InsRunResult runGnssIns(const io::Dataset& ds, const fusion::InsConfig& config,
   }
   ins.finish();
   r.stats = ins.stats();
-  const json nhc = nhcMeanInnovation(r.stats);
-  if (!nhc.is_null() &&
-      std::max(std::abs(nhc[0].get<double>()), std::abs(nhc[1].get<double>())) > kNhcBiasWarnMps) {
+  const std::optional<Eigen::Vector2d> nhc = nhcMeanInnovation(r.stats);
+  if (nhc && nhc->cwiseAbs().maxCoeff() > kNhcBiasWarnMps) {
     spdlog::warn(
         "the non-holonomic constraint's mean innovation is {:.2f} m/s lateral, {:.2f} m/s "
         "vertical: the IMU may be turned in the vehicle; set fusion.ins.mount_rpy_deg, or "
         "fusion.ins.use_nhc false",
-        nhc[0].get<double>(), nhc[1].get<double>());
+        nhc->x(), nhc->y());
   }
   r.final_state = ins.state();
   r.time_offset_sigma_s = std::sqrt(ins.covariance()(fusion::kInsTau, fusion::kInsTau));
@@ -185,6 +183,7 @@ void writeGnssInsOutputs(const std::filesystem::path& out, const InsRunResult& r
 
 json gnssInsReport(const io::Dataset& ds, const InsRunResult& r, const InsReportContext& ctx) {
   const fusion::InsStats& s = r.stats;
+  const std::optional<Eigen::Vector2d> nhc = nhcMeanInnovation(s);
   json report;
   report["gvio_version"] = GVIO_VERSION;
   report["command_line"] = ctx.command_line;
@@ -215,7 +214,7 @@ json gnssInsReport(const io::Dataset& ds, const InsRunResult& r, const InsReport
       {"velocity_rejected", s.velocity_rejected},
       {"nhc_used", s.nhc_used},
       {"nhc_rejected", s.nhc_rejected},
-      {"nhc_mean_innovation_mps", nhcMeanInnovation(s)},
+      {"nhc_mean_innovation_mps", nhc ? json{nhc->x(), nhc->y()} : json(nullptr)},
       {"registered", s.t_init_ns.has_value()},
       {"t_init", s.t_init_ns ? json(seconds(*s.t_init_ns)) : json(nullptr)},
       {"ms_per_fix", {{"mean", cost.mean}, {"p95", cost.p95}, {"max", cost.max}}},
