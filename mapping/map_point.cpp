@@ -15,12 +15,4 @@ MapPoint makeMapPoint(float x, float y, float z, float intensity, std::uint32_t 
   return p;
 }
 
-MapCloud mergeMapClouds(const MapCloud& sparse, const MapCloud& dense) {
-  MapCloud merged;
-  merged.reserve(sparse.size() + dense.size());
-  merged += sparse;
-  merged += dense;
-  return merged;
-}
-
 }  // namespace gvio::mapping

@@ -27,9 +27,6 @@ using MapCloud = pcl::PointCloud<MapPoint>;
 [[nodiscard]] MapPoint makeMapPoint(float x, float y, float z, float intensity,
                                     std::uint32_t observations, MapPointSource source);
 
-// The file map: sparse landmarks first, then dense points (both already in the map frame).
-[[nodiscard]] MapCloud mergeMapClouds(const MapCloud& sparse, const MapCloud& dense);
-
 }  // namespace gvio::mapping
 
 POINT_CLOUD_REGISTER_POINT_STRUCT(

@@ -37,17 +37,12 @@ void writeTreeAtomic(const std::filesystem::path& file,
 
 // The merged cloud (sparse landmarks first, then the dense points) as PCL's blob without a merged
 // copy in between: the dense cloud is released as soon as its bytes are in the blob, so the map
-// is held once. pcl::toPCLPointCloud2 copies the point structs byte for byte (point_step =
-// sizeof(MapPoint)), which is what is done here for the two clouds one after the other.
+// is held once. pcl::toPCLPointCloud2 copies the point structs byte for byte (it sets point_step
+// = sizeof(MapPoint) and the fields' offsets in the struct), which is what is done here for the
+// two clouds one after the other; the header (fields, point_step) comes from an empty cloud.
 pcl::PCLPointCloud2 mapBlob(const mapping::MapCloud& sparse, mapping::MapCloud& dense) {
   pcl::PCLPointCloud2 blob;
   pcl::toPCLPointCloud2(mapping::MapCloud{}, blob);
-  static_assert(sizeof(mapping::MapPoint) % 4 == 0);
-  if (blob.point_step != sizeof(mapping::MapPoint)) {  // not PCL's layout: the plain copy
-    pcl::toPCLPointCloud2(mapping::mergeMapClouds(sparse, dense), blob);
-    mapping::MapCloud().swap(dense);
-    return blob;
-  }
   const std::size_t n = sparse.size() + dense.size();
   blob.width = static_cast<std::uint32_t>(n);
   blob.height = 1;
