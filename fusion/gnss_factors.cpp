@@ -18,10 +18,23 @@ using odometry::poseQ;
 
 RelativePoseFactor::RelativePoseFactor(const Eigen::Isometry3d& T_i_j, double sigma_rot_rad,
                                        double sigma_pos_m)
-    : dR_(T_i_j.rotation()),
-      dp_(T_i_j.translation()),
-      inv_sigma_rot_(1.0 / sigma_rot_rad),
-      inv_sigma_pos_(1.0 / sigma_pos_m) {}
+    : dR_(T_i_j.rotation()), dp_(T_i_j.translation()), sqrt_info_(Matrix6d::Zero()) {
+  sqrt_info_.diagonal() << Eigen::Vector3d::Constant(1.0 / sigma_rot_rad),
+      Eigen::Vector3d::Constant(1.0 / sigma_pos_m);
+}
+
+RelativePoseFactor::RelativePoseFactor(const Eigen::Isometry3d& T_i_j,
+                                       const Matrix6d& sqrt_information)
+    : dR_(T_i_j.rotation()), dp_(T_i_j.translation()), sqrt_info_(sqrt_information) {}
+
+Eigen::Matrix<double, 6, 1> RelativePoseFactor::error(const Eigen::Isometry3d& T_i,
+                                                      const Eigen::Isometry3d& T_j) const {
+  const Eigen::Matrix3d R_i = T_i.rotation();
+  Eigen::Matrix<double, 6, 1> e;
+  e << odometry::logSo3(dR_.transpose() * R_i.transpose() * T_j.rotation()),
+      R_i.transpose() * (T_j.translation() - T_i.translation()) - dp_;
+  return e;
+}
 
 bool RelativePoseFactor::Evaluate(double const* const* parameters, double* residuals,
                                   double** jacobians) const {
@@ -29,25 +42,26 @@ bool RelativePoseFactor::Evaluate(double const* const* parameters, double* resid
   const Eigen::Matrix3d R_j = poseQ(parameters[1]).normalized().toRotationMatrix();
   const Eigen::Vector3d a = R_i.transpose() * (poseP(parameters[1]) - poseP(parameters[0]));
   const Eigen::Vector3d r_rot = odometry::logSo3(dR_.transpose() * R_i.transpose() * R_j);
-  Eigen::Map<Eigen::Matrix<double, 6, 1>> r(residuals);
-  r << inv_sigma_rot_ * r_rot, inv_sigma_pos_ * (a - dp_);
+  Eigen::Matrix<double, 6, 1> e;
+  e << r_rot, a - dp_;
+  Eigen::Map<Eigen::Matrix<double, 6, 1>>{residuals} = sqrt_info_ * e;
   if (jacobians == nullptr) return true;
   const Eigen::Matrix3d Jr_inv = odometry::rightJacobianInverseSo3(r_rot);
   using Jac6x7 = Eigen::Matrix<double, 6, 7, Eigen::RowMajor>;
   if (jacobians[0] != nullptr) {
     // d r_rot / d dphi_i = -Jr^-1 R_j^T R_i; d a / d dphi_i = hat(a); d a / d dp_i = -I.
-    Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
-    J.topLeftCorner<3, 3>() = -inv_sigma_rot_ * Jr_inv * R_j.transpose() * R_i;
-    J.bottomLeftCorner<3, 3>() = inv_sigma_pos_ * hat(a);
-    J.bottomRightCorner<3, 3>() = -inv_sigma_pos_ * Eigen::Matrix3d::Identity();
-    Eigen::Map<Jac6x7>{jacobians[0]} = J * poseMinusJacobian(parameters[0]);
+    Matrix6d J = Matrix6d::Zero();
+    J.topLeftCorner<3, 3>() = -Jr_inv * R_j.transpose() * R_i;
+    J.bottomLeftCorner<3, 3>() = hat(a);
+    J.bottomRightCorner<3, 3>() = -Eigen::Matrix3d::Identity();
+    Eigen::Map<Jac6x7>{jacobians[0]} = sqrt_info_ * J * poseMinusJacobian(parameters[0]);
   }
   if (jacobians[1] != nullptr) {
     // d r_rot / d dphi_j = Jr^-1; d a / d dp_j = R_i^T R_j.
-    Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
-    J.topLeftCorner<3, 3>() = inv_sigma_rot_ * Jr_inv;
-    J.bottomRightCorner<3, 3>() = inv_sigma_pos_ * R_i.transpose() * R_j;
-    Eigen::Map<Jac6x7>{jacobians[1]} = J * poseMinusJacobian(parameters[1]);
+    Matrix6d J = Matrix6d::Zero();
+    J.topLeftCorner<3, 3>() = Jr_inv;
+    J.bottomRightCorner<3, 3>() = R_i.transpose() * R_j;
+    Eigen::Map<Jac6x7>{jacobians[1]} = sqrt_info_ * J * poseMinusJacobian(parameters[1]);
   }
   return true;
 }
@@ -105,6 +119,24 @@ bool GaussMarkovFactor::Evaluate(double const* const* parameters, double* residu
   }
   if (jacobians != nullptr && jacobians[1] != nullptr) {
     Eigen::Map<Jac3>{jacobians[1]} = inv_sigma_w_ * Eigen::Matrix3d::Identity();
+  }
+  return true;
+}
+
+TiltFactor::TiltFactor(const Eigen::Vector3d& g_b, double sigma_rad)
+    : g_b_(g_b.normalized()), inv_sigma_(1.0 / sigma_rad) {}
+
+bool TiltFactor::Evaluate(double const* const* parameters, double* residuals,
+                          double** jacobians) const {
+  const Eigen::Matrix3d R = poseQ(parameters[0]).normalized().toRotationMatrix();
+  const Eigen::Vector3d v = R.transpose() * Eigen::Vector3d::UnitZ();
+  Eigen::Map<Eigen::Vector3d>{residuals} = inv_sigma_ * (v - g_b_);
+  if (jacobians != nullptr && jacobians[0] != nullptr) {
+    // (R Exp(dphi))^T e_z = Exp(-dphi) v ~ v - hat(dphi) v = v + hat(v) dphi.
+    Eigen::Matrix<double, 3, 6> J = Eigen::Matrix<double, 3, 6>::Zero();
+    J.leftCols<3>() = inv_sigma_ * hat(v);
+    Eigen::Map<Eigen::Matrix<double, 3, 7, Eigen::RowMajor>>{jacobians[0]} =
+        J * poseMinusJacobian(parameters[0]);
   }
   return true;
 }

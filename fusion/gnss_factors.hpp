@@ -9,18 +9,27 @@
 
 namespace gvio::fusion {
 
-// VIO relative motion between two nodes, T_i^-1 T_j = dT (measured), whitened per axis:
-//   r = (Log(dR^T R_i^T R_j) / sigma_rot, (R_i^T (p_j - p_i) - dp) / sigma_pos).
+// Relative motion between two nodes, T_i^-1 T_j = dT (measured: VIO motion, a loop closure),
+// whitened by the square root S of its information matrix (S^T S = Sigma^-1):
+//   e = (Log(dR^T R_i^T R_j), R_i^T (p_j - p_i) - dp),  r = S e.
+// The measurement's covariance is therefore stated in (rotation perturbation on the right of dR,
+// translation in node i's frame), the convention loop verification uses.
 class RelativePoseFactor final : public ceres::SizedCostFunction<6, 7, 7> {
  public:
+  using Matrix6d = Eigen::Matrix<double, 6, 6>;
+  // Isotropic: S = diag(1/sigma_rot x3, 1/sigma_pos x3).
   RelativePoseFactor(const Eigen::Isometry3d& T_i_j, double sigma_rot_rad, double sigma_pos_m);
+  RelativePoseFactor(const Eigen::Isometry3d& T_i_j, const Matrix6d& sqrt_information);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
+  // The unwhitened error e at the two poses (for chi-square tests: e^T Sigma^-1 e = |r|^2).
+  [[nodiscard]] Eigen::Matrix<double, 6, 1> error(const Eigen::Isometry3d& T_i,
+                                                  const Eigen::Isometry3d& T_j) const;
 
  private:
   Eigen::Matrix3d dR_;
   Eigen::Vector3d dp_;
-  double inv_sigma_rot_, inv_sigma_pos_;
+  Matrix6d sqrt_info_;
 };
 
 // A GNSS fix of the antenna on node i: the antenna sits at q_b in the node's body frame (the lever
@@ -63,6 +72,22 @@ class GaussMarkovFactor final : public ceres::SizedCostFunction<3, 3, 3> {
 
  private:
   double phi_, inv_sigma_w_;
+};
+
+// The gravity direction in the body as the VIO (with an IMU) observes it, g_b = R_w_b^T e_z: roll
+// and pitch are observable from the IMU at every pose, so a pose graph need not (and must not) move
+// them with the yaw and position its loops and fixes correct (VINS-Mono's 4-DoF pose graph, Qin
+// et al. 2018, sec. VIII; here a stiff 6-DoF factor instead of a reduced parameterisation):
+//   r = (R_i^T e_z - g_b) / sigma  (3 residuals, rank 2: rotation about e_z is free).
+class TiltFactor final : public ceres::SizedCostFunction<3, 7> {
+ public:
+  TiltFactor(const Eigen::Vector3d& g_b, double sigma_rad);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  Eigen::Vector3d g_b_;
+  double inv_sigma_;
 };
 
 }  // namespace gvio::fusion
