@@ -140,7 +140,8 @@ void GnssFusion::Impl::noteAccepted(std::int64_t t_ns) {
 }
 
 void GnssFusion::Impl::noteOutcome(const Pair& pair, bool used) {
-  stats.fixes.push_back({pair.t_ns, pair.p_enu, used ? FixStatus::kUsed : FixStatus::kRejected});
+  stats.fixes.push_back({pair.t_ns, pair.p_enu, used ? FixStatus::kUsed : FixStatus::kRejected,
+                         pair.fix.sigma_h_m, pair.fix.sigma_v_m});
   if (used) {
     noteAccepted(pair.t_ns);
   } else {
@@ -290,7 +291,7 @@ void GnssFusion::Impl::processFix(const GnssFix& fix) {
   if (!T_w_b) {
     ++stats.fixes_unmatched;
     stats.fixes.push_back({fix.t_ns, enu.toEnu({fix.lat_deg, fix.lon_deg, fix.h_ellipsoid_m}),
-                           FixStatus::kUnmatched});
+                           FixStatus::kUnmatched, fix.sigma_h_m, fix.sigma_v_m});
     return;
   }
   Pair pair{fix.t_ns, *T_w_b, enu.toEnu({fix.lat_deg, fix.lon_deg, fix.h_ellipsoid_m}), fix};
@@ -341,7 +342,8 @@ void GnssFusion::finish() {
     s.pending.pop_front();
   }
   for (const Impl::Pair& p : s.alignment_pairs) {
-    s.stats.fixes.push_back({p.t_ns, p.p_enu, FixStatus::kUnaligned});
+    s.stats.fixes.push_back(
+        {p.t_ns, p.p_enu, FixStatus::kUnaligned, p.fix.sigma_h_m, p.fix.sigma_v_m});
   }
   s.alignment_pairs.clear();
   std::sort(s.stats.fixes.begin(), s.stats.fixes.end(),

@@ -75,6 +75,7 @@ struct FixOutcome {
   std::int64_t t_ns = 0;                            // after the receiver time offset
   Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();  // the antenna position the fix reports
   FixStatus status = FixStatus::kUsed;
+  double sigma_h_m = 0.0, sigma_v_m = 0.0;  // as the fix reports them
 };
 
 struct FusionStats {

@@ -273,6 +273,7 @@ FrameResult VioEstimator::addFrame(std::int64_t t_ns, const cv::Mat& left, const
   const double ms_tracking = msSince(start);
   const auto start_estimator = Clock::now();
   r = s.process(t_ns, tracked);
+  s.last_features = tracked.features;
   r.ms_tracking = ms_tracking;
   r.ms_estimator = msSince(start_estimator);
   if (!r.T_w_b.matrix().allFinite() || !r.v_w_mps.allFinite()) {
@@ -290,6 +291,10 @@ std::vector<VioEvent> VioEstimator::takeEvents() {
 
 const VioCounters& VioEstimator::counters() const {
   return impl_->counters;
+}
+
+const std::vector<Feature>& VioEstimator::lastFeatures() const {
+  return impl_->last_features;
 }
 
 std::vector<LandmarkEstimate> VioEstimator::landmarks() const {

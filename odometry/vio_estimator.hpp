@@ -18,6 +18,7 @@
 
 #include <opencv2/core/mat.hpp>
 
+#include "odometry/feature_tracker.hpp"
 #include "odometry/imu_preintegration.hpp"
 #include "odometry/measurements.hpp"
 #include "odometry/vio_config.hpp"
@@ -84,6 +85,9 @@ class VioEstimator {
   // Events since the last call (moved out).
   std::vector<VioEvent> takeEvents();
   [[nodiscard]] const VioCounters& counters() const;
+  // The front end's features of the last frame given to addFrame (rectified pixels; a feature's
+  // id is its landmark's id).
+  [[nodiscard]] const std::vector<Feature>& lastFeatures() const;
   // Landmarks currently in the window with a valid depth.
   [[nodiscard]] std::vector<LandmarkEstimate> landmarks() const;
 

@@ -69,6 +69,7 @@ struct VioEstimator::Impl {
   ImuBuffer imu;
   SlidingWindow window;
   LatestState latest;
+  std::vector<Feature> last_features;              // the front end's features of the last frame
   std::optional<Eigen::Isometry3d> previous_pose;  // the frame before `latest` (constant velocity)
   bool imu_aligned = false;  // the window is gravity-aligned with velocities and biases
   bool waiting_reported = false;
