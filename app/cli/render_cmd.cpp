@@ -110,7 +110,7 @@ Command addRenderCommand(CLI::App& app) {
       app.add_subcommand("render", "Draw a run's map and trajectories off-screen (EGL) into a PNG");
   sub->add_option("--run", o->run,
                   "Run folder (trajectory.tum / trajectory_vio.tum; optional groundtruth.tum, "
-                  "map.pcd, map.ot / map.bt, gnss_fixes.csv, report.json)")
+                  "map.pcd, map.ot / map.bt, gnss_fixes.csv, report.json, loops.csv)")
       ->required();
   sub->add_option("--view", o->view,
                   "topdown (map), perspective (3-D cloud), octomap (voxels), or error (colour = "

@@ -163,6 +163,7 @@ RunFiles readRunDir(const fs::path& dir, const RunReadOptions& options) {
   if (options.outages && fs::exists(dir / "report.json")) {
     run.outages = readOutages(dir / "report.json");
   }
+  if (options.loops && fs::exists(dir / "loops.csv")) run.loops = readLoopsCsv(dir / "loops.csv");
   if (options.cloud && fs::exists(dir / "map.pcd")) run.cloud = readMapCloud(dir / "map.pcd");
   if (options.occupancy) {
     for (const char* name : {"map.ot", "map.bt"}) {  // the ColorOcTree carries colour: prefer it

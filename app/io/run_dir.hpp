@@ -1,8 +1,8 @@
 #pragma once
 // What a `gvio run --out DIR` folder holds that other commands read back (DESIGN.md section 4):
 // trajectories, the map (map.pcd, map.ot / map.bt), the GNSS fixes as the run judged them
-// (gnss_fixes.csv) and the GNSS outages (report.json). Every file is optional except one
-// trajectory; a view draws what exists.
+// (gnss_fixes.csv), the GNSS outages (report.json) and the loop-closure candidates (loops.csv).
+// Every file is optional except one trajectory; a view draws what exists.
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
@@ -10,6 +10,7 @@
 #include <optional>
 #include <vector>
 
+#include "io/loops_csv.hpp"
 #include "odometry/trajectory.hpp"
 
 namespace gvio::io {
@@ -62,6 +63,7 @@ struct RunFiles {
   std::optional<OccupancyMap> occupancy;  // map.ot, else map.bt
   std::optional<std::vector<GnssFixRecord>> gnss_fixes;  // gnss_fixes.csv
   std::vector<TimeSpan> outages;                         // report.json "outages"
+  std::optional<std::vector<LoopCsvRow>> loops;          // loops.csv
 };
 
 struct RunReadOptions {
@@ -70,6 +72,7 @@ struct RunReadOptions {
   bool occupancy = true;   // read map.ot / map.bt when present
   bool gnss_fixes = true;  // read gnss_fixes.csv when present
   bool outages = true;     // read report.json's outages when present
+  bool loops = true;       // read loops.csv when present
 };
 
 // Reads every file present (the map files as `options` asks). Throws InputError when the folder

@@ -6,6 +6,7 @@
 
 #include "eval/evaluate.hpp"
 #include "odometry/error.hpp"
+#include "viz/loop_layer.hpp"
 #include "viz/map_layers.hpp"
 
 namespace gvio::viz {
@@ -145,7 +146,7 @@ render::RenderCamera topDownClearOfOverlays(const Eigen::AlignedBox3d& box, int 
 
 // Orthographic, north up. Layers by height, since the camera looks straight down: the cloud at
 // its own heights, then (lifted above everything) used fixes, trajectories, outages, rejected and
-// skipped fixes, start/end.
+// skipped fixes, accepted loop closures, start/end.
 void buildTopDown(const io::RunFiles& run, int width, int height, ViewSpec& v) {
   const bool map = run.cloud && !run.cloud->p_enu.empty();
   Eigen::AlignedBox3d fit;  // what the view must show
@@ -174,12 +175,17 @@ void buildTopDown(const io::RunFiles& run, int width, int height, ViewSpec& v) {
     }
   }
   const double top = fit.max().z() + 1.0;
-  std::vector<render::PointCloud> fixes;
+  std::vector<render::PointCloud> markers;  // fixes and loop keyframes
   std::vector<render::LegendEntry> fix_legend;
-  if (run.gnss_fixes) addGnssFixes(*run.gnss_fixes, top + 1.0, top + 4.0, fixes, fix_legend);
+  if (run.gnss_fixes) addGnssFixes(*run.gnss_fixes, top + 1.0, top + 4.0, markers, fix_legend);
   addTrajectories(run, v, map, top + 2.0);
   addOutages(run, v, top + 3.0);
   v.annotations.legend.insert(v.annotations.legend.end(), fix_legend.begin(), fix_legend.end());
+  // Loop keyframes are poses of the main trajectory, already inside `fit`.
+  if (run.loops) {
+    addLoopClosures(*run.loops, mainTrajectory(run), top + 4.5, v.scene.polylines, markers,
+                    v.annotations.legend);
+  }
   Eigen::AlignedBox3d box = fit;
   box.extend(Eigen::Vector3d(fit.min().x(), fit.min().y(), top + 6.0));
   v.camera = topDownClearOfOverlays(box, width, height);
@@ -196,7 +202,7 @@ void buildTopDown(const io::RunFiles& run, int width, int height, ViewSpec& v) {
     v.scene.point_clouds.push_back(colouredCloud(*run.cloud, style, &keep));
     heightBar(z_lo, z_hi, v);
   }
-  v.scene.point_clouds.insert(v.scene.point_clouds.end(), fixes.begin(), fixes.end());
+  v.scene.point_clouds.insert(v.scene.point_clouds.end(), markers.begin(), markers.end());
   auto ends = endpoints(positions(mainTrajectory(run)));
   for (auto& p : ends.points) p.z() = top + 5.0;
   v.scene.point_clouds.push_back(ends);
@@ -302,6 +308,7 @@ io::RunReadOptions readOptionsFor(RunView view,
   o.occupancy = view == RunView::kOctomap;
   o.gnss_fixes = view == RunView::kTopDown;
   o.outages = view != RunView::kError;
+  o.loops = view == RunView::kTopDown;
   return o;
 }
 

@@ -2,7 +2,8 @@
 // The images `gvio render` draws of a run: which primitives, camera and 2-D annotations each
 // view uses. Pure scene building; the CLI owns the EGL context and the file output.
 //  - topdown:     orthographic ENU map, north up: the cloud coloured by height (when map.pcd
-//                 exists), trajectories, GNSS fixes (used / rejected / skipped) and outages on top.
+//                 exists), trajectories, GNSS fixes (used / rejected / skipped), outages and
+//                 accepted loop closures (loops.csv) on top.
 //  - perspective: the dense cloud from behind and above the start of the drive, with the
 //                 trajectory (without map.pcd: an orbit view of the trajectories, as before maps).
 //  - octomap:     the OctoMap's occupied voxels as shaded cubes, same viewpoint.

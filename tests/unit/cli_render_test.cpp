@@ -4,6 +4,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "io/loops_csv.hpp"
 #include "io/trajectory_io.hpp"
 #include "render_map_fixture.hpp"
 #include "support/fixtures.hpp"
@@ -130,6 +131,30 @@ TEST_F(CliRender, BadMapFilesAreOneLineExit2) {
   writeText(map_run / "report.json", "{");
   io::writeTum(map_run / "groundtruth.tum", syntheticDrive());
   EXPECT_EQ(runGvio(args + " --view error").exit_code, 0);
+}
+
+// loops.csv is read for the topdown view only: malformed, it fails that view in one line naming
+// the file and line, and leaves the other views alone.
+TEST_F(CliRender, LoopsCsvIsDrawnAndWhenMalformedOneLineExit2) {
+  io::LoopCsvRow closure;  // the end of the loop drive, back near its start
+  closure.query_t_ns = 10'800'000'000LL;
+  closure.candidate_t_ns = 1'000'000'000LL;
+  closure.accepted = true;
+  closure.reason = "ok";
+  io::writeLoopsCsv(run_ / "loops.csv", {closure});
+  const std::string args =
+      "render --run " + run_.string() + " --size 320x200 --out " + out("l.png");
+  auto r = runGvio(args + " --view topdown");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(cv::imread(out("l.png")).empty());
+  writeText(run_ / "loops.csv", std::string(io::kLoopsCsvHeader) +
+                                    "\n10.8,1.0,3.0,15.0,10,5,0.5,0.1,0.2,accepted,ok\n"
+                                    "10.9,1.0,3.0,15.0,-10,0,nan,nan,nan,rejected,few_matches\n");
+  r = runGvio(args + " --view topdown");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("loops.csv:3: negative matches '-10'"));
+  EXPECT_EQ(runGvio(args + " --view perspective").exit_code, 0);
 }
 
 // With no EGL vendor library (glvnd finds none), every path fails and the CLI says so in one line.

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "io/input_error.hpp"
+#include "io/loops_csv.hpp"
 #include "io/run_dir.hpp"
 #include "render_map_fixture.hpp"
 
@@ -109,6 +110,22 @@ TEST_F(RenderMapIo, MalformedGnssFixesNameFileAndLine) {
     EXPECT_THAT(msg, HasSubstr(needle)) << text;
     EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
   }
+}
+
+TEST_F(RenderMapIo, LoopsCsvIsReadWhenPresentAndAsked) {
+  EXPECT_FALSE(io::readRunDir(run_).loops.has_value());  // the fixture has none
+  const std::string header = std::string(io::kLoopsCsvHeader) + "\n";
+  writeText(run_ / "loops.csv", header + "20.5,2.0,1.5,15.0,300,120,0.6,1.2,0.8,accepted,ok\n");
+  const io::RunFiles r = io::readRunDir(run_);
+  ASSERT_TRUE(r.loops.has_value());
+  ASSERT_EQ(r.loops->size(), 1U);
+  EXPECT_EQ(r.loops->at(0).query_t_ns, 20'500'000'000LL);
+  EXPECT_TRUE(r.loops->at(0).accepted);
+  writeText(run_ / "loops.csv", header + "20.5,2.0,1.5,15.0,300,120,0.6,1.2,0.8,kept,ok\n");
+  EXPECT_THAT(failure(), HasSubstr("loops.csv:2: verdict 'kept'"));
+  io::RunReadOptions options;
+  options.loops = false;
+  EXPECT_FALSE(io::readRunDir(run_, options).loops.has_value());
 }
 
 TEST_F(RenderMapIo, MalformedReportNamesFileAndLine) {
