@@ -3,12 +3,17 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <charconv>
+#include <cmath>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "cli/app.hpp"
 #include "eval/evaluate.hpp"
 #include "eval/plots.hpp"
+#include "eval/revisits.hpp"
+#include "eval/revisits_plot.hpp"
 #include "io/atomic_write.hpp"
 #include "io/intervals.hpp"
 #include "io/text.hpp"
@@ -21,6 +26,8 @@ namespace {
 struct EvalCliOptions {
   std::string ref, est, ref_format = "auto", est_format = "auto";
   std::optional<std::string> ref_times, est_times, json, plot, est_aligned, outages;
+  // Taken as text and parsed here, so a bad value is a one-line InvalidInput like other input.
+  std::optional<std::string> revisits_radius, revisits_min_separation;
   std::string align = "none", relation = "trans", rpe_unit = "frames", plot_plane = "auto";
   std::optional<double> rpe_delta;
   double t_max_diff_s = 0.01, t_offset_s = 0.0;
@@ -54,19 +61,61 @@ nlohmann::json statsJson(const eval::Stats& s) {
           {"min", s.min},   {"max", s.max},   {"sse", s.sse},       {"n", s.n}};
 }
 
-std::string statsTable(const std::string& title, const eval::Stats& s) {
+// evo's rows in evo's (alphabetical) order; p95 where given; the count as `count_label`.
+std::string statsTable(const std::string& title, const eval::Stats& s,
+                       std::optional<double> p95 = std::nullopt, const char* count_label = "n") {
   std::string out = title + "\n";
-  const std::pair<const char*, double> rows[] = {
+  std::vector<std::pair<const char*, double>> rows = {
       {"max", s.max},   {"mean", s.mean}, {"median", s.median}, {"min", s.min},
       {"rmse", s.rmse}, {"sse", s.sse},   {"std", s.std}};
+  if (p95) rows.insert(rows.begin() + 4, {"p95", *p95});
   for (const auto& [name, value] : rows) out += fmt::format("{:>10}  {:.6f}\n", name, value);
-  return out + fmt::format("{:>10}  {}\n", "n", s.n);
+  return out + fmt::format("{:>10}  {}\n", count_label, s.n);
 }
 
-nlohmann::json resultJson(const eval::EvalResult& r, const EvalCliOptions& o) {
+// Divided, not multiplied by 1e-9, so that whole seconds print whole (30, not 30.000000000000004).
+double separationS(std::int64_t t_ns) {
+  return static_cast<double>(t_ns) / 1e9;
+}
+
+// "reference poses within 5 m and at least 30 s apart"
+std::string revisitsScope(const eval::RevisitOptions& o) {
+  return fmt::format("reference poses within {} m and at least {} s apart", o.radius_m,
+                     separationS(o.min_separation_ns));
+}
+
+std::string revisitsTable(const eval::RevisitResult& v) {
+  if (!v.stats) return fmt::format("revisits: no pair of {}\n", revisitsScope(v.options));
+  return statsTable(fmt::format("revisit consistency |(p_est_j - p_est_i) - (p_ref_j - p_ref_i)| "
+                                "(m) over pairs of {}",
+                                revisitsScope(v.options)),
+                    v.stats->stats, v.stats->p95, "pairs");
+}
+
+// The statistics are null when no pair qualifies, so the keys are always there.
+nlohmann::json revisitsJson(const eval::RevisitResult& v) {
+  nlohmann::json j = {{"radius_m", v.options.radius_m},
+                      {"min_separation_s", separationS(v.options.min_separation_ns)},
+                      {"pairs", v.pairs.size()}};
+  if (v.stats) {
+    j.update(statsJson(v.stats->stats));
+    j["p95"] = v.stats->p95;
+  } else {
+    for (const char* key : {"rmse", "mean", "median", "std", "min", "max", "sse", "p95"}) {
+      j[key] = nullptr;
+    }
+    j["n"] = 0;
+  }
+  return j;
+}
+
+nlohmann::json resultJson(const eval::EvalResult& r,
+                          const std::optional<eval::RevisitResult>& revisits,
+                          const EvalCliOptions& o) {
   nlohmann::json j;
   j["ape"] = statsJson(r.ape_stats);
   if (r.rpe) j["rpe"] = statsJson(r.rpe->stats);
+  if (revisits) j["revisits"] = revisitsJson(*revisits);
   const auto& a = r.alignment;
   j["alignment"] = {{"mode", o.align},
                     {"rotation",
@@ -102,6 +151,14 @@ std::array<int, 2> planeAxes(const std::string& plane, const std::vector<Eigen::
   return eval::choosePlane(ref);
 }
 
+std::string plotPrefix(const EvalCliOptions& o) {
+  std::string prefix = *o.plot;
+  for (const char* ext : {".png", ".svg"}) {
+    if (prefix.ends_with(ext)) prefix.resize(prefix.size() - 4);
+  }
+  return prefix;
+}
+
 std::vector<std::string> plot(const eval::EvalResult& r, const EvalCliOptions& o) {
   eval::PlotData d;
   d.title =
@@ -126,15 +183,60 @@ std::vector<std::string> plot(const eval::EvalResult& r, const EvalCliOptions& o
     }
   }
   d.plane = planeAxes(o.plot_plane, d.p_ref);
-  std::string prefix = *o.plot;
-  for (const char* ext : {".png", ".svg"}) {
-    if (prefix.ends_with(ext)) prefix.resize(prefix.size() - 4);
+  return eval::writePlots(d, plotPrefix(o));
+}
+
+std::vector<std::string> plotRevisits(const eval::EvalResult& r, const eval::RevisitResult& v,
+                                      const EvalCliOptions& o) {
+  eval::RevisitPlotData d;
+  d.title = fmt::format("Revisit consistency (pairs within {} m, >= {} s apart), alignment: {}",
+                        v.options.radius_m, separationS(v.options.min_separation_ns),
+                        alignmentName(eval::parseAlignment(o.align)));
+  for (std::size_t i = 0; i < r.ref.size(); ++i) {
+    d.p_ref.emplace_back(r.ref[i].topRightCorner<3, 1>());
+    d.p_est.emplace_back(r.est[i].topRightCorner<3, 1>());
   }
-  return eval::writePlots(d, prefix);
+  d.plane = planeAxes(o.plot_plane, d.p_ref);
+  return eval::writeRevisitsPlot(d, v, plotPrefix(o));
 }
 
 std::int64_t secondsToNsOption(double s) {
   return static_cast<std::int64_t>(std::llround(s * 1e9));
+}
+
+// The whole text must be a finite number accepted by `ok`, else a one-line error naming the option.
+double parseNumberOption(const char* option, const std::string& text, bool (*ok)(double),
+                         const char* expected) {
+  double value = 0.0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (ec != std::errc() || ptr != end || !std::isfinite(value) || !ok(value)) {
+    throw gvio::InvalidInput(fmt::format("{} '{}': expected {}", option, text, expected));
+  }
+  return value;
+}
+
+// Revisit options from --revisits R and --revisits-min-separation S; none without --revisits.
+std::optional<eval::RevisitOptions> revisitOptions(const EvalCliOptions& o) {
+  if (!o.revisits_radius) {
+    if (o.revisits_min_separation) {
+      throw gvio::InvalidInput("--revisits-min-separation: only used with --revisits R");
+    }
+    return std::nullopt;
+  }
+  eval::RevisitOptions v;
+  v.radius_m = parseNumberOption(
+      "--revisits", *o.revisits_radius, [](double r) { return r > 0.0; },
+      "a finite radius > 0 (metres)");
+  if (o.revisits_min_separation) {
+    const double s = parseNumberOption(
+        "--revisits-min-separation", *o.revisits_min_separation, [](double x) { return x >= 0.0; },
+        "a finite number of seconds >= 0");
+    // Saturates: a separation beyond int64 nanoseconds (292 years) simply admits no pair.
+    v.min_separation_ns =
+        s * 1e9 >= 9.2e18 ? std::numeric_limits<std::int64_t>::max() : secondsToNsOption(s);
+  }
+  return v;
 }
 
 int runEval(const EvalCliOptions& o) {
@@ -149,9 +251,12 @@ int runEval(const EvalCliOptions& o) {
       o.plot_plane != "yz") {
     throw gvio::InvalidInput("--plot-plane: expected auto, xy, xz or yz");
   }
+  const std::optional<eval::RevisitOptions> revisit_options = revisitOptions(o);
   const Trajectory ref = load(o.ref, o.ref_format, o.ref_times);
   const Trajectory est = load(o.est, o.est_format, o.est_times);
   const eval::EvalResult r = eval::evaluate(ref, est, opt);
+  std::optional<eval::RevisitResult> revisits;
+  if (revisit_options) revisits = eval::computeRevisits(r.ref, r.est, r.t_ns, *revisit_options);
 
   std::string report = fmt::format("{} of {} reference / {} estimate poses {}\nalignment: {}",
                                    r.ref.size(), r.ref_poses, r.est_poses,
@@ -164,11 +269,15 @@ int runEval(const EvalCliOptions& o) {
                                             eval::describe(opt.relation), *o.rpe_delta, o.rpe_unit),
                                 r.rpe->stats);
   }
+  if (revisits) report += "\n" + revisitsTable(*revisits);
   std::cout << report;
-  if (o.json) io::writeTextAtomic(*o.json, resultJson(r, o).dump(2) + "\n");
+  if (o.json) io::writeTextAtomic(*o.json, resultJson(r, revisits, o).dump(2) + "\n");
   if (o.est_aligned) writeAligned(*o.est_aligned, r);
   if (o.plot) {
     for (const auto& file : plot(r, o)) spdlog::info("wrote {}", file);
+    if (revisits) {
+      for (const auto& file : plotRevisits(r, *revisits, o)) spdlog::info("wrote {}", file);
+    }
   }
   return 0;
 }
@@ -202,9 +311,16 @@ Command addEvalCommand(CLI::App& app) {
   sub->add_option("--json", o->json,
                   "Write {\"ape\": {...}, \"rpe\": {...}} statistics to this file");
   sub->add_option("--est-aligned", o->est_aligned, "Write the aligned, associated estimate (TUM)");
-  sub->add_option("--plot", o->plot, "Write PREFIX_{trajectory,error,axes}.{png,svg}");
+  sub->add_option("--plot", o->plot,
+                  "Write PREFIX_{trajectory,error,axes}.{png,svg} (and PREFIX_revisits.{png,svg} "
+                  "with --revisits)");
   sub->add_option("--plot-plane", o->plot_plane, "Top-down plane of the trajectory plot")
       ->check(CLI::IsMember({"auto", "xy", "xz", "yz"}));
+  sub->add_option("--revisits", o->revisits_radius,
+                  "Revisit consistency: error of the estimated relative position of every pair "
+                  "of reference poses within R m of each other (R > 0)");
+  sub->add_option("--revisits-min-separation", o->revisits_min_separation,
+                  "Least time between the two poses of a revisit pair (s, default 30)");
   sub->add_option("--outages", o->outages,
                   "Intervals 't0 t1' (s, trajectory time base) shaded in plots");
   return {sub, [o] { return runEval(*o); }};
