@@ -32,7 +32,7 @@ struct GlobalGraphConfig {
   double bias_ratio = 0.5;
   double bias_tau_s = 60.0;
   bool tilt = true;                // tilt factors (only when the VIO had an IMU)
-  double tilt_sigma_rad = 0.0017;  // their 1 sigma (0.1 deg)
+  double tilt_sigma_rad = 0.017;  // their 1 sigma (1 deg)
   // A loop whose error against the solution exceeds this chi-square (6 DoF; 99.9 %: 22.46) is
   // switched off.
   double loop_chi2 = 22.46;

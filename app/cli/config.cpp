@@ -154,66 +154,15 @@ void applyOverride(const std::string& assignment, std::map<std::string, ConfigKe
 
 }  // namespace
 
-std::optional<fusion::Lla> FusionAppConfig::originLla() const {
-  if (origin == "first-fix") return std::nullopt;
-  fusion::Lla lla;
-  char tail = 0;
-  if (std::sscanf(origin.c_str(), "%lf,%lf,%lf%c", &lla.lat_deg, &lla.lon_deg, &lla.h_ellipsoid_m,
-                  &tail) != 3 ||
-      !fusion::isValidLla(lla)) {
-    throw InvalidInput("config: fusion.origin must be first-fix or lat,lon,h (got '" + origin +
-                       "')");
-  }
-  return lla;
-}
-
-fusion::InsConfig FusionAppConfig::insConfig(const ImuNoise& imu_noise) const {
-  fusion::InsConfig c = ins;
-  c.lever_arm_b = fusion.lever_arm_b;
-  c.receiver_time_offset_s = fusion.receiver_time_offset_s;
-  c.gate_chi2 = fusion.gate_chi2;
-  c.max_consecutive_rejections = fusion.max_consecutive_rejections;
-  c.outage_s = fusion.outage_s;
-  c.imu = imu_noise;
-  return c;
-}
-
-void FusionAppConfig::validate() const {
-  (void)originLla();
-  fusion.validate();
-  insConfig(ImuNoise{}).validate();
-}
-
-void VioConfig::validate() const {
-  if (mode != "auto" && mode != "stereo-imu" && mode != "mono-imu" && mode != "stereo") {
-    throw InvalidInput("config: vio.mode must be one of auto, stereo-imu, mono-imu, stereo (got '" +
-                       mode + "')");
-  }
-  try {
-    estimator.validate();
-  } catch (const InvalidInput& e) {
-    // The tracker names its keys from its own section; here they live under vio.tracker.
-    const std::string what = e.what();
-    const std::string prefix = "config: tracker.";
-    if (what.rfind(prefix, 0) == 0) {
-      throw InvalidInput("config: vio.tracker." + what.substr(prefix.size()));
-    }
-    throw;
-  }
-}
-
 void AppConfig::validate() const {
-  dataset.validate();
-  imu.noise.validate();
-  vio.validate();
-  fusion.validate();
-  map.map.validate();
+  RunConfig::validate();
   sim.validate();
 }
 
 std::vector<ConfigKey> configKeys(AppConfig& c) {
   odometry::EstimatorConfig& e = c.vio.estimator;
   mapping::MapConfig& m = c.map.map;
+  mapping::LoopConfig& l = c.loops.detection;
   return {
       text("dataset.kitti_gnss_source", c.dataset.kitti_gnss_source),
       number("dataset.gap_factor", c.dataset.gap_factor),
@@ -329,6 +278,35 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("map.dense.stereo.max_range_m", m.dense.stereo.max_range_m),
       number("map.occupancy.resolution_m", m.occupancy.resolution_m),
       number("map.occupancy.max_range_m", m.occupancy.max_range_m),
+      boolean("loops.enabled", l.enabled),
+      number("loops.min_separation_s", l.search.min_separation_s),
+      number("loops.max_heading_deg", l.search.max_heading_deg),
+      number("loops.search_radius_m", l.search.search_radius_m),
+      number("loops.search_sigmas", l.search.search_sigmas),
+      integer("loops.max_candidates", l.search.max_candidates),
+      integer("loops.orb_features", l.features.orb_features),
+      integer("loops.orb_levels", l.features.orb_levels),
+      integer("loops.orb_fast_threshold", l.features.orb_fast_threshold),
+      number("loops.min_depth_m", l.features.min_depth_m),
+      number("loops.max_depth_m", l.features.max_depth_m),
+      integer("loops.max_hamming", l.match.max_hamming),
+      number("loops.ratio", l.match.ratio),
+      integer("loops.min_inliers", l.match.min_inliers),
+      number("loops.ransac_threshold_px", l.match.ransac_threshold_px),
+      integer("loops.ransac_iterations", l.match.ransac_iterations),
+      number("loops.max_reprojection_px", l.match.max_reprojection_px),
+      number("loops.correction_floor_m", l.search.correction_floor_m),
+      number("loops.correction_floor_deg", l.search.correction_floor_deg),
+      integer("loops.consistent_keyframes", l.search.consistent_keyframes),
+      integer("loops.consistency_window", l.search.consistency_window),
+      number("loops.consistency_m", l.search.consistency_m),
+      number("loops.consistency_deg", l.search.consistency_deg),
+      number("loops.sigma_floor_m", l.sigma_floor_m),
+      number("loops.sigma_floor_deg", l.sigma_floor_deg),
+      number("loops.graph_chi2", c.loops.graph_chi2),
+      integer("loops.graph_max_rounds", c.loops.graph_max_rounds),
+      integer("loops.graph_max_iterations", c.loops.graph_max_iterations),
+      number("loops.graph_tilt_sigma_deg", c.loops.graph_tilt_sigma_deg),
       number("sim.image_noise_dn", c.sim.image_noise_dn),
       boolean("sim.exposure_change", c.sim.exposure_change),
       number("sim.exposure_amplitude", c.sim.exposure_amplitude),

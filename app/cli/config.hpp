@@ -8,61 +8,19 @@
 #include <string_view>
 #include <vector>
 
-#include "fusion/gnss_fusion.hpp"
-#include "fusion/gnss_ins.hpp"
-#include "io/reader_config.hpp"
-#include "mapping/map_config.hpp"
-#include "odometry/measurements.hpp"
-#include "odometry/vio_config.hpp"
+#include "run/run_config.hpp"
 #include "sim/gnss_error.hpp"
 #include "sim/sim_config.hpp"
 
 namespace gvio::cli {
 
-struct ImuConfig {
-  // Used when the dataset states its own noise (EuRoC imu0/sensor.yaml) unless false.
-  bool prefer_dataset_noise = true;
-  ImuNoise noise;
-};
+using run::FusionAppConfig;
+using run::ImuConfig;
+using run::MapAppConfig;
+using run::VioConfig;
 
-// gvio run's estimator (YAML section `vio:`). The IMU noise comes from `imu:` (or the dataset),
-// the tracker's stereo flag from the mode, so those two fields of `estimator` are set per run.
-struct VioConfig {
-  // auto | stereo-imu | mono-imu | stereo; auto picks from the dataset's sensors at run time.
-  std::string mode = "auto";
-  odometry::EstimatorConfig estimator;
-
-  void validate() const;  // throws InvalidInput naming the key
-};
-
-// gvio run's GNSS fusion (YAML section `fusion:`); the mode comes from --gnss.
-struct FusionAppConfig {
-  // Origin of the local ENU frame: "first-fix", or "lat,lon,h" (deg, deg, ellipsoidal m).
-  std::string origin = "first-fix";
-  fusion::FusionConfig fusion;
-  // GNSS/INS without a camera (fusion.ins.*); its lever arm, time offset, gate, rejections and
-  // outage length are fusion.*'s, and its IMU noise imu.*'s: see insConfig().
-  fusion::InsConfig ins;
-
-  // `ins` with the shared fusion.* values and `imu_noise` filled in.
-  [[nodiscard]] fusion::InsConfig insConfig(const ImuNoise& imu_noise) const;
-  // The origin as given, nullopt for first-fix; throws InvalidInput for malformed text.
-  [[nodiscard]] std::optional<fusion::Lla> originLla() const;
-  void validate() const;  // throws InvalidInput naming the key
-};
-
-// gvio run's map (YAML section `map:`): sparse landmarks, dense stereo, OctoMap occupancy.
-struct MapAppConfig {
-  bool enabled = true;  // false: no map files (the run is trajectories only)
-  mapping::MapConfig map;
-};
-
-struct AppConfig {
-  io::ReaderConfig dataset;
-  ImuConfig imu;
-  VioConfig vio;
-  FusionAppConfig fusion;
-  MapAppConfig map;
+// Every section of the configuration: gvio run's (run::RunConfig) and the simulator's.
+struct AppConfig : run::RunConfig {
   sim::SimConfig sim;
 
   void validate() const;  // throws InvalidInput naming the key

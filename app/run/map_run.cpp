@@ -125,10 +125,10 @@ double msSince(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-MapRunResult buildAndWriteMap(MapRecorder& recorder, const Trajectory* fused,
+MapRunResult buildAndWriteMap(MapRecorder& recorder, const Trajectory* fused, bool georeferenced,
                               const std::filesystem::path& out) {
   MapRunResult r;
-  r.frame = fused != nullptr && !fused->empty() ? "enu" : "vio_world";
+  r.frame = georeferenced && fused != nullptr && !fused->empty() ? "enu" : "vio_world";
   const mapping::PoseLookup poses = mapPoses(recorder, fused);
   auto start = std::chrono::steady_clock::now();
   r.map = recorder.buildClouds(poses);

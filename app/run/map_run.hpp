@@ -66,7 +66,8 @@ mapping::PoseLookup mapPoses(const MapRecorder& recorder, const Trajectory* fuse
 // `gvio export --to las`) only when the map is in ENU (the run is georeferenced: georef.json
 // written); otherwise the reason is logged and a map.las of an earlier run in `out` is removed.
 // An empty cloud writes no cloud files and warns.
-MapRunResult buildAndWriteMap(MapRecorder& recorder, const Trajectory* fused,
+// `georeferenced`: `fused` is in local ENU (else the VIO world, e.g. loop-closed without GNSS).
+MapRunResult buildAndWriteMap(MapRecorder& recorder, const Trajectory* fused, bool georeferenced,
                               const std::filesystem::path& out);
 
 // report.json's "map": frame, counts, per-keyframe cost of each stage (ms mean/p95/max), memory.

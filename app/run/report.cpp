@@ -71,6 +71,7 @@ json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportCon
   report["wall_s"] = run.wall_s;
   report["peak_rss_mb"] = ctx.peak_rss_mb;
   if (!ctx.map.is_null()) report["map"] = ctx.map;
+  if (!ctx.loops.is_null()) report["loops"] = ctx.loops;
   if (ctx.gnss) {
     report["gnss"] = gnssReport(*ctx.gnss, ds.gnss.size());
     report["gnss"]["requested"] = ctx.gnss_requested;
@@ -90,6 +91,11 @@ json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportCon
   }
   report["events"] = std::move(events);
   if (ctx.evaluation) report["evaluation"] = evaluationJson(*ctx.evaluation);
+  if (ctx.evaluation_loop_closed) {
+    report["evaluation_loop_closed"] = evaluationJson(*ctx.evaluation_loop_closed);
+    report["evaluation_loop_closed"]["trajectory"] =
+        "trajectory.tum: the loop-closed trajectory in the VIO world, SE(3) aligned";
+  }
   if (ctx.evaluation_fused) {
     const UnalignedOutcome& e = *ctx.evaluation_fused;
     report["evaluation_fused"] =

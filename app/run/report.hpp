@@ -17,9 +17,13 @@ struct ReportContext {
   std::string gnss_requested = "off";  // the --gnss value as given
   nlohmann::json gnss_noise;           // --gnss-noise applied to the fixes, null when none
   nlohmann::json map;                  // run/map_run.hpp mapReport, null without a map
+  nlohmann::json loops;                // run/loop_run.hpp loopsReport, null without loop closure
   std::string imu_noise_source;        // "dataset" or "config"; empty when the mode has no IMU
   double peak_rss_mb = 0.0;
-  const EvaluationOutcome* evaluation = nullptr;       // null: the dataset has no ground truth
+  const EvaluationOutcome* evaluation = nullptr;  // null: the dataset has no ground truth
+  // The loop-closed trajectory in the VIO world (trajectory.tum without GNSS), SE(3) aligned as
+  // `evaluation`; null when not run.
+  const EvaluationOutcome* evaluation_loop_closed = nullptr;
   const GnssRunResult* gnss = nullptr;                 // null: no GNSS fusion ran
   const UnalignedOutcome* evaluation_fused = nullptr;  // null: not evaluated
   // The causal (online) fused trajectory when trajectory.tum is the smoothed one; else null.

@@ -1,0 +1,44 @@
+#pragma once
+// gvio run's pipeline (DESIGN.md section 1): a dataset in, a run folder out (section 4), as named
+// stages over one run state: dataset -> GNSS degradation -> VIO (keyframes recorded for the map
+// and for loop closure) -> GNSS fusion -> loop closure + global pose graph -> trajectories ->
+// map -> report. A dataset with an IMU and GNSS but no camera runs GNSS/INS instead of the VIO
+// stages. app/cli turns the command line into a RunRequest and nothing more.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "io/dataset.hpp"
+#include "run/map_passes.hpp"
+#include "run/run_config.hpp"
+#include "run/vio_runner.hpp"
+#include "sim/gnss_error.hpp"
+
+namespace gvio::run {
+
+struct RunRequest {
+  std::filesystem::path dataset;
+  std::optional<io::DatasetFormat> format;  // nullopt: detect
+  std::string gnss = "auto";                // auto | off | kf | graph
+  // --gnss-noise: its name as given (none, spp, rtk, a file) and the model behind it.
+  std::string gnss_noise_name = "none";
+  std::optional<sim::GnssErrorModel> gnss_noise;
+  std::uint64_t seed = 1;  // of the GNSS degradation
+  std::filesystem::path out;
+  std::optional<TwoPassSpans> two_pass;
+  std::string command_line;  // report.json
+  std::string config_yaml;   // the effective configuration, written as config.yaml
+  ProgressFn progress;       // VIO frames done / total; may be empty
+  std::function<void()> progress_done;
+};
+
+// "auto", "off", "kf" or "graph"; else InvalidInput naming --gnss.
+void checkGnssOption(const std::string& gnss);
+
+// Runs every stage and writes the run folder; returns the exit code. Throws InvalidInput (or
+// io::InputError) for bad input, naming the file and line.
+int runPipeline(const RunRequest& request, const RunConfig& config);
+
+}  // namespace gvio::run

@@ -1,0 +1,106 @@
+// gvio run's last stage: the self-evaluation, report.json, config.yaml and the summary lines.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "io/atomic_write.hpp"
+#include "run/pipeline_stages.hpp"
+#include "run/report.hpp"
+#include "run/stats.hpp"
+
+namespace gvio::run {
+namespace {
+
+struct Evaluations {
+  std::optional<EvaluationOutcome> loop_closed;  // VIO world, SE(3) aligned
+  std::optional<UnalignedOutcome> fused, fused_online;
+};
+
+Evaluations evaluate(const RunState& s) {
+  Evaluations e;
+  const io::Dataset& ds = s.dataset;
+  if (!ds.groundtruth || !ds.groundtruth->hasTimestamps()) return e;
+  if (!s.georeferenced && s.loops && !s.final_trajectory.empty()) {
+    e.loop_closed = evaluateAgainstTruth(*ds.groundtruth, s.final_trajectory);
+  }
+  // Without alignment the truth must be in the same ENU frame: only with an explicit origin.
+  if (s.gnss && !s.gnss->fused.empty() && s.config.fusion.originLla()) {
+    e.fused = evaluateUnaligned(*ds.groundtruth, s.gnss->fused);
+    if (!s.gnss->fused_online.empty()) {
+      e.fused_online = evaluateUnaligned(*ds.groundtruth, s.gnss->fused_online);
+    }
+  }
+  return e;
+}
+
+void logSummary(const RunState& s, const Evaluations& e) {
+  std::string ape = "no ground truth";
+  if (s.evaluation) {
+    ape = s.evaluation->result
+              ? fmt::format("APE (SE3) rmse {:.3f} m over {:.0f} m",
+                            s.evaluation->result->ape_se3.rmse, s.evaluation->result->path_length_m)
+              : "not evaluated";
+    if (e.loop_closed && e.loop_closed->result) {
+      ape += fmt::format(" ({:.3f} m loop-closed)", e.loop_closed->result->ape_se3.rmse);
+    }
+  }
+  if (s.loops) {
+    const nlohmann::json& j = s.loops_report;
+    if (s.loops->graph.rounds == 0) {
+      spdlog::info("loops: {} candidates verified, none accepted: the trajectory is unchanged",
+                   j["verified"].get<int>());
+    } else {
+      spdlog::info(
+          "loops: {} candidates verified, {} accepted, {} kept by the global graph ({} rounds, {}, "
+          "{:.0f} ms)",
+          j["verified"].get<int>(), j["accepted"].get<int>(), j["graph"]["active_loops"].get<int>(),
+          j["graph"]["rounds"].get<int>(), s.loops->graph.converged ? "converged" : "NOT converged",
+          s.loops->graph.ms_solve);
+    }
+    if (s.loops->graph.rounds > 0 && !s.loops->graph.converged) {
+      spdlog::warn("the global pose graph did not converge: {}", s.loops->graph.termination);
+    }
+  }
+  if (s.gnss) {
+    std::string fused_ape;
+    if (e.fused && e.fused->ape) {
+      fused_ape = fmt::format(", fused APE (no alignment) rmse {:.3f} m", e.fused->ape->rmse);
+      if (e.fused_online && e.fused_online->ape) {
+        fused_ape += fmt::format(" final, {:.3f} m online", e.fused_online->ape->rmse);
+      }
+    }
+    spdlog::info("GNSS {}: {} fixes used, {} rejected, {} skipped, {} outage(s){}",
+                 fusion::toString(s.gnss->mode), s.gnss->stats.fixes_used,
+                 s.gnss->stats.fixes_rejected, s.gnss->screening.skipped(),
+                 s.gnss->stats.outages.size(), fused_ape);
+  }
+  const TimingSummary total = summarizeTimings(s.vio.timings.total_ms);
+  spdlog::info(
+      "{} frames, {} keyframes, {} poses written, {}, {:.1f} ms/frame (p95 {:.1f}); wrote {}",
+      s.vio.counters.frames, s.vio.counters.keyframes, s.vio.trajectory.size(), ape, total.mean,
+      total.p95, s.request.out.string());
+}
+
+}  // namespace
+
+void writeReport(RunState& s) {
+  const Evaluations e = evaluate(s);
+  ReportContext context;
+  context.map = s.map_report;
+  context.loops = s.loops_report;
+  context.command_line = s.request.command_line;
+  context.gnss_requested = s.request.gnss;
+  context.gnss_noise = s.gnss_noise;
+  context.imu_noise_source = s.imu_noise_source;
+  context.peak_rss_mb = peakRssMb();
+  context.evaluation = s.evaluation ? &*s.evaluation : nullptr;
+  context.evaluation_loop_closed = e.loop_closed ? &*e.loop_closed : nullptr;
+  context.gnss = s.gnss ? &*s.gnss : nullptr;
+  context.evaluation_fused = e.fused ? &*e.fused : nullptr;
+  context.evaluation_fused_online = e.fused_online ? &*e.fused_online : nullptr;
+  io::writeTextAtomic(s.request.out / "report.json",
+                      buildReport(s.dataset, s.vio, context).dump(2) + "\n");
+  io::writeTextAtomic(s.request.out / "config.yaml", s.request.config_yaml);
+  logSummary(s, e);
+}
+
+}  // namespace gvio::run

@@ -1,0 +1,127 @@
+// gvio run's middle stages: VIO, GNSS fusion, loop closure, trajectories, map.
+#include "run/pipeline_stages.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "io/atomic_write.hpp"
+#include "io/loops_csv.hpp"
+#include "io/trajectory_io.hpp"
+
+namespace gvio::run {
+
+void runVioStage(RunState& s) {
+  const io::Dataset& ds = s.dataset;
+  s.estimator = s.config.vio.estimator;
+  s.estimator.mode = chooseVioMode(s.config.vio.mode, ds);
+  const bool dataset_noise = ds.imu_noise && s.config.imu.prefer_dataset_noise;
+  s.estimator.imu_noise = dataset_noise ? *ds.imu_noise : s.config.imu.noise;
+  s.estimator.validate();
+  if (odometry::usesImu(s.estimator.mode))
+    s.imu_noise_source = dataset_noise ? "dataset" : "config";
+  const std::filesystem::path& out = s.request.out;
+  makeOutputDir(out);
+  spdlog::info("{} {} ({}): {} frames, mode {}", io::toString(ds.format), ds.root.string(),
+               ds.variant, ds.frames.size(), odometry::toString(s.estimator.mode));
+  if (s.config.map.enabled) s.map_recorder.emplace(s.config.map.map);
+  if (s.config.loops.detection.enabled) {
+    s.loop_recorder.emplace(s.config.loops.detection.features);
+  }
+  KeyframeFn on_keyframe;
+  if (s.map_recorder || s.loop_recorder) {
+    on_keyframe = [&s](const KeyframeInput& kf) {
+      if (s.map_recorder) s.map_recorder->addKeyframe(kf);
+      if (s.loop_recorder) s.loop_recorder->addKeyframe(kf);
+    };
+  }
+  s.vio = runVio(ds, s.estimator, s.request.progress, on_keyframe);
+  if (s.request.progress_done) s.request.progress_done();
+  if (s.vio.trajectory.empty()) {
+    spdlog::warn("the estimator never initialised: trajectory_vio.tum is empty");
+    io::writeTextAtomic(out / "trajectory_vio.tum", "");
+  } else {
+    io::writeTum(out / "trajectory_vio.tum", s.vio.trajectory);
+  }
+  if (ds.groundtruth && ds.groundtruth->hasTimestamps()) {
+    io::writeTum(out / "groundtruth.tum", *ds.groundtruth);  // for gvio render's error view
+    s.evaluation = evaluateAgainstTruth(*ds.groundtruth, s.vio.trajectory);
+    if (!s.evaluation->result) spdlog::warn("no evaluation: {}", s.evaluation->error);
+  }
+}
+
+void runGnssStage(RunState& s) {
+  // auto fuses with the graph when the dataset has fixes; without fixes every mode is pure VIO.
+  const std::string& gnss = s.request.gnss;
+  const bool fuse = gnss != "off" && !s.dataset.gnss.empty();
+  if (!fuse && (gnss == "kf" || gnss == "graph")) {
+    spdlog::warn("--gnss {}: the dataset has no GNSS fixes: pure VIO", gnss);
+  }
+  if (!fuse) return;
+  const fusion::FusionMode mode =
+      gnss == "kf" ? fusion::FusionMode::kKf : fusion::FusionMode::kGraph;
+  s.gnss = fuseGnss(s.dataset, s.vio.trajectory, mode, s.config.fusion.fusion,
+                    s.config.fusion.originLla(), odometry::usesImu(s.estimator.mode));
+  if (s.gnss && !s.gnss->fused.empty()) {
+    s.final_trajectory = s.gnss->fused;
+    s.georeferenced = true;
+  }
+}
+
+void runLoopStage(RunState& s) {
+  if (!s.loop_recorder || s.loop_recorder->empty()) return;
+  try {
+    s.loops =
+        closeLoops(*s.loop_recorder, s.vio.trajectory, s.gnss ? &*s.gnss : nullptr,
+                   odometry::usesImu(s.estimator.mode), s.config.loops, s.config.fusion.fusion);
+  } catch (const std::exception& e) {
+    // A bug or an odd drive inside loop closure must not cost the user the run.
+    spdlog::warn("loop closure failed ({}): the run goes on without it", e.what());
+    s.loops_report = {{"error", e.what()}};
+  }
+  s.loop_recorder.reset();  // the features are no longer needed: free them before the map
+  if (!s.loops) return;
+  io::writeLoopsCsv(s.request.out / "loops.csv", s.loops->rows);
+  s.loops_report = loopsReport(*s.loops);
+  if (s.loops->trajectory.empty()) return;
+  s.final_trajectory = s.loops->trajectory;
+  s.georeferenced = s.loops->frame == "enu";
+  if (s.georeferenced && s.gnss) {
+    // trajectory.tum is now the loop-closed one; the smoother's covariances describe the poses
+    // before the loops, so they are not written with it.
+    s.gnss->fused = s.loops->trajectory;
+    s.gnss->fused_covariance.clear();
+  }
+}
+
+void writeTrajectories(RunState& s) {
+  if (s.gnss) {
+    writeGeoreferencedOutputs(s.request.out, *s.gnss);  // trajectory.tum in ENU, georef.json
+  }
+  if (!s.georeferenced && !s.final_trajectory.empty()) {
+    io::writeTum(s.request.out / "trajectory.tum", s.final_trajectory);  // loop-closed VIO world
+  }
+}
+
+void runMapStage(RunState& s) {
+  if (!s.map_recorder || s.map_recorder->empty()) {
+    if (s.request.two_pass) {
+      spdlog::warn("--two-pass: the run has no map (map.enabled false, or no keyframe)");
+    }
+    return;
+  }
+  const Trajectory* poses = s.final_trajectory.empty() ? nullptr : &s.final_trajectory;
+  nlohmann::json two_pass_report;
+  if (s.request.two_pass) {  // before the build, which frees the keyframes' dense points
+    two_pass_report = twoPassReport(*s.map_recorder, mapPoses(*s.map_recorder, poses),
+                                    *s.request.two_pass, s.dataset.frames.front().t_ns);
+  }
+  const MapRunResult map = buildAndWriteMap(*s.map_recorder, poses, s.georeferenced, s.request.out);
+  s.map_report = mapReport(*s.map_recorder, map);
+  if (s.request.two_pass) s.map_report["two_pass"] = two_pass_report;
+  s.map_report["las"] = map.las;
+  s.map_recorder.reset();
+  spdlog::info("map ({}): {} landmarks, {} dense points, {} occupied voxels", map.frame,
+               map.map.counts.sparse_points, map.map.counts.dense_points,
+               map.map.counts.occupied_leaves);
+}
+
+}  // namespace gvio::run
