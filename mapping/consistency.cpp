@@ -107,25 +107,19 @@ OccupancySurfaceStats occupancyNearSurface(const TriangleMeshIndex& surface,
   return stats;
 }
 
-PassAgreement twoPassAgreement(const MapCloud& pass1, const MapCloud& pass2,
-                               double overlap_radius_m) {
+std::vector<double> overlapDistances(const MapCloud& pass1, const MapCloud& pass2,
+                                     double overlap_radius_m) {
   if (!std::isfinite(overlap_radius_m) || overlap_radius_m <= 0.0) {
     throw InvalidInput("two-pass agreement: overlap radius must be > 0 m");
   }
-  PassAgreement result;
-  result.n_pass1 = pass1.size();
-  result.n_pass2 = pass2.size();
-  result.overlap_radius_m = overlap_radius_m;
-  if (pass1.empty() || pass2.empty()) return result;
-
+  std::vector<double> d;
+  if (pass1.empty() || pass2.empty()) return d;
   // KdTreeFLANN is precompiled for PCL's own point types: index plain xyz copies.
   auto reference = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   reference->reserve(pass1.size());
   for (const auto& p : pass1) reference->push_back(pcl::PointXYZ(p.x, p.y, p.z));
   pcl::KdTreeFLANN<pcl::PointXYZ> tree;
   tree.setInputCloud(reference);
-
-  std::vector<double> d;
   pcl::Indices index(1);
   std::vector<float> dist2(1);
   const double r2 = overlap_radius_m * overlap_radius_m;
@@ -133,13 +127,32 @@ PassAgreement twoPassAgreement(const MapCloud& pass1, const MapCloud& pass2,
     if (tree.nearestKSearch(pcl::PointXYZ(p.x, p.y, p.z), 1, index, dist2) < 1) continue;
     if (static_cast<double>(dist2[0]) <= r2) d.push_back(std::sqrt(static_cast<double>(dist2[0])));
   }
+  return d;
+}
+
+PassAgreement agreementOf(std::vector<double>& d, std::size_t n_pass1, std::size_t n_pass2,
+                          double overlap_radius_m, double within_m) {
+  PassAgreement result;
+  result.n_pass1 = n_pass1;
+  result.n_pass2 = n_pass2;
+  result.overlap_radius_m = overlap_radius_m;
+  result.within_m = within_m;
   result.n_overlap = d.size();
-  result.overlap_fraction = static_cast<double>(d.size()) / static_cast<double>(result.n_pass2);
-  if (d.empty()) return result;
+  if (d.empty() || n_pass2 == 0) return result;
+  result.overlap_fraction = static_cast<double>(d.size()) / static_cast<double>(n_pass2);
   result.mean_m = std::accumulate(d.begin(), d.end(), 0.0) / static_cast<double>(d.size());
+  result.fraction_within = static_cast<double>(std::count_if(
+                               d.begin(), d.end(), [&](double v) { return v <= within_m; })) /
+                           static_cast<double>(d.size());
   result.median_m = percentile(d, 0.5);
   result.p90_m = percentile(d, 0.9);
   return result;
+}
+
+PassAgreement twoPassAgreement(const MapCloud& pass1, const MapCloud& pass2,
+                               double overlap_radius_m, double within_m) {
+  std::vector<double> d = overlapDistances(pass1, pass2, overlap_radius_m);
+  return agreementOf(d, pass1.size(), pass2.size(), overlap_radius_m, within_m);
 }
 
 }  // namespace gvio::mapping

@@ -58,10 +58,22 @@ struct PassAgreement {
   double median_m = 0.0;          // over the overlapping points
   double mean_m = 0.0;
   double p90_m = 0.0;
+  double within_m = 0.0;         // the agreement bound asked for (0: none)
+  double fraction_within = 0.0;  // of the overlapping points, those within within_m
 };
 
 [[nodiscard]] PassAgreement twoPassAgreement(const MapCloud& pass1, const MapCloud& pass2,
-                                             double overlap_radius_m);
+                                             double overlap_radius_m, double within_m = 0.0);
+
+// The distances behind twoPassAgreement: for each pass-2 point with a pass-1 point within
+// overlap_radius_m, the distance to the nearest one.
+[[nodiscard]] std::vector<double> overlapDistances(const MapCloud& pass1, const MapCloud& pass2,
+                                                   double overlap_radius_m);
+
+// twoPassAgreement's statistics of given overlap distances (`d` is reordered).
+[[nodiscard]] PassAgreement agreementOf(std::vector<double>& d, std::size_t n_pass1,
+                                        std::size_t n_pass2, double overlap_radius_m,
+                                        double within_m);
 
 // Percentile q in [0, 1] with linear interpolation between order statistics (numpy's default);
 // reorders `values`. 0 for an empty vector.

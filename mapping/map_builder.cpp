@@ -215,12 +215,21 @@ void MapBuilder::occupancyInto(const std::vector<std::optional<Eigen::Isometry3d
 
 MapCloud MapBuilder::keyframePoints(std::int64_t t0_ns, std::int64_t t1_ns,
                                     const PoseLookup& pose_of) const {
+  std::vector<std::size_t> indices;
+  const auto& keyframes = store_.keyframes();
+  for (std::size_t i = 0; i < keyframes.size(); ++i) {
+    if (keyframes[i].t_ns >= t0_ns && keyframes[i].t_ns <= t1_ns) indices.push_back(i);
+  }
+  return keyframePoints(indices, pose_of);
+}
+
+MapCloud MapBuilder::keyframePoints(const std::vector<std::size_t>& indices,
+                                    const PoseLookup& pose_of) const {
   const auto attached = attachedLandmarks();
   MapCloud out;
   const auto& keyframes = store_.keyframes();
-  for (std::size_t i = 0; i < keyframes.size(); ++i) {
-    if (keyframes[i].t_ns < t0_ns || keyframes[i].t_ns > t1_ns) continue;
-    const auto pose = pose_of(keyframes[i].t_ns);
+  for (const std::size_t i : indices) {
+    const auto pose = pose_of(keyframes.at(i).t_ns);
     if (!pose) continue;
     const auto source =
         keyframes[i].has_dense ? MapPointSource::kDenseStereo : MapPointSource::kSparseLandmark;

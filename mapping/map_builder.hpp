@@ -94,6 +94,9 @@ class MapBuilder {
   // (consistency.hpp).
   [[nodiscard]] MapCloud keyframePoints(std::int64_t t0_ns, std::int64_t t1_ns,
                                         const PoseLookup& pose_of) const;
+  // The same for the keyframes at `indices` (into store().keyframes()).
+  [[nodiscard]] MapCloud keyframePoints(const std::vector<std::size_t>& indices,
+                                        const PoseLookup& pose_of) const;
 
   // The stored VIO poses as a PoseLookup (maps in the VIO world frame). It refers to this
   // builder: do not use it after the builder is moved or destroyed.

@@ -73,8 +73,8 @@ struct LoopRunResult {
   // Loop-closed T_frame_b of every VIO pose; empty when no loop was accepted and kept by the
   // global graph (then the earlier stages' trajectory stands, unchanged).
   Trajectory trajectory;
-  std::size_t records_bytes = 0;     // memory the loop features held
-  std::vector<double> ms_features;   // per keyframe
+  std::size_t records_bytes = 0;    // memory the loop features held
+  std::vector<double> ms_features;  // per keyframe
   double ms_detection_total = 0.0;
 };
 

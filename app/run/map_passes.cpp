@@ -5,6 +5,12 @@
 #include <cmath>
 #include <regex>
 
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_types.h>
+
+#include <algorithm>
+#include <optional>
+
 #include "mapping/consistency.hpp"
 #include "odometry/error.hpp"
 
@@ -23,7 +29,108 @@ std::size_t keyframesIn(const MapRecorder& recorder, std::int64_t t0_ns, std::in
   return n;
 }
 
+struct Revisits {
+  std::vector<std::vector<std::size_t>> runs;        // second-pass keyframes, consecutive runs
+  std::vector<std::vector<std::size_t>> first_pass;  // per run, its first-pass keyframes
+};
+
+// Second-pass keyframes and their first passes (see revisitReport), over a kd-tree of the
+// keyframes' final positions.
+Revisits findRevisits(const MapRecorder& recorder, const mapping::PoseLookup& pose_of) {
+  const auto& keyframes = recorder.builder().store().keyframes();
+  std::vector<std::optional<Eigen::Isometry3d>> pose(keyframes.size());
+  auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  std::vector<std::size_t> cloud_index;
+  for (std::size_t k = 0; k < keyframes.size(); ++k) {
+    pose[k] = pose_of(keyframes[k].t_ns);
+    if (!pose[k]) continue;
+    const Eigen::Vector3f p = pose[k]->translation().cast<float>();
+    cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    cloud_index.push_back(k);
+  }
+  Revisits r;
+  if (cloud->empty()) return r;
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud(cloud);
+  const double min_cos = std::cos(kRevisitMaxHeadingDeg * M_PI / 180.0);
+  const auto min_sep_ns = static_cast<std::int64_t>(kRevisitMinSeparationS * 1e9);
+  std::size_t last = 0;
+  for (std::size_t c = 0; c < cloud->size(); ++c) {
+    const std::size_t j = cloud_index[c];
+    pcl::Indices found;
+    std::vector<float> d2;
+    tree.radiusSearch((*cloud)[c], kRevisitRadiusM, found, d2);
+    std::vector<std::size_t> earlier;
+    for (const auto f : found) {
+      const std::size_t i = cloud_index[static_cast<std::size_t>(f)];
+      if (keyframes[j].t_ns - keyframes[i].t_ns < min_sep_ns) continue;
+      if (pose[i]->rotation().col(0).dot(pose[j]->rotation().col(0)) < min_cos) continue;
+      earlier.push_back(i);
+    }
+    if (earlier.empty()) continue;
+    // A gap of more than a few keyframes starts a new run.
+    if (r.runs.empty() || j > last + 5) {
+      r.runs.emplace_back();
+      r.first_pass.emplace_back();
+    }
+    r.runs.back().push_back(j);
+    r.first_pass.back().insert(r.first_pass.back().end(), earlier.begin(), earlier.end());
+    last = j;
+  }
+  for (std::size_t k = 0; k < r.runs.size(); ++k) {
+    std::vector<std::size_t>& f = r.first_pass[k];
+    std::sort(f.begin(), f.end());
+    f.erase(std::unique(f.begin(), f.end()), f.end());
+    const std::vector<std::size_t>& run = r.runs[k];
+    std::erase_if(f, [&](std::size_t i) { return std::binary_search(run.begin(), run.end(), i); });
+  }
+  return r;
+}
+
 }  // namespace
+
+nlohmann::json revisitReport(const MapRecorder& recorder, const mapping::PoseLookup& pose_of) {
+  const Revisits revisits = findRevisits(recorder, pose_of);
+  std::vector<double> d;
+  std::size_t n1 = 0, n2 = 0, second = 0;
+  for (std::size_t k = 0; k < revisits.runs.size(); ++k) {
+    const mapping::MapCloud pass1 =
+        recorder.builder().keyframePoints(revisits.first_pass[k], pose_of);
+    const mapping::MapCloud pass2 = recorder.builder().keyframePoints(revisits.runs[k], pose_of);
+    const std::vector<double> dk = mapping::overlapDistances(pass1, pass2, kTwoPassOverlapRadiusM);
+    d.insert(d.end(), dk.begin(), dk.end());
+    n1 += pass1.size();
+    n2 += pass2.size();
+    second += revisits.runs[k].size();
+  }
+  const mapping::PassAgreement a =
+      mapping::agreementOf(d, n1, n2, kTwoPassOverlapRadiusM, kRevisitWithinM);
+  nlohmann::json j = {
+      {"radius_m", kRevisitRadiusM},
+      {"min_separation_s", kRevisitMinSeparationS},
+      {"max_heading_deg", kRevisitMaxHeadingDeg},
+      {"runs", revisits.runs.size()},
+      {"second_pass_keyframes", second},
+      {"pass1_points", n1},
+      {"pass2_points", n2},
+      {"overlap_radius_m", a.overlap_radius_m},
+      {"overlap_points", a.n_overlap},
+      {"overlap_fraction", a.overlap_fraction},
+      {"within_m", kRevisitWithinM},
+      {"fraction_within", a.fraction_within},
+      {"median_m", a.median_m},
+      {"p90_m", a.p90_m},
+      {"target_fraction", kRevisitTargetFraction},
+      {"meets_target", a.n_overlap > 0 && a.fraction_within >= kRevisitTargetFraction}};
+  if (a.n_overlap > 0) {
+    spdlog::info(
+        "map at revisits: {} second-pass keyframes in {} runs, {:.1f} % of {} overlapping points "
+        "within {} m of the first pass (median {:.3f} m)",
+        second, revisits.runs.size(), 100.0 * a.fraction_within, a.n_overlap, kRevisitWithinM,
+        a.median_m);
+  }
+  return j;
+}
 
 TwoPassSpans parseTwoPass(const std::string& text) {
   static const std::regex kSpans(

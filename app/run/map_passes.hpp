@@ -38,4 +38,20 @@ TwoPassSpans parseTwoPass(const std::string& text);
 nlohmann::json twoPassReport(const MapRecorder& recorder, const mapping::PoseLookup& pose_of,
                              const TwoPassSpans& spans, std::int64_t t_first_ns);
 
+// The map at revisits, found by itself (issue 15: "for the places passed twice, >= 95 % of the
+// second pass's dense points within 0.2 m of the first pass's"). A keyframe is a second pass of
+// every keyframe at least kRevisitMinSeparationS older whose final position lies within
+// kRevisitRadiusM and whose heading agrees within kRevisitMaxHeadingDeg (the cameras saw the same
+// scene). Runs of consecutive second-pass keyframes are compared, each against the points of its
+// first-pass keyframes (outside the run), with the same overlap rule as --two-pass; the report
+// gives the share of overlapping second-pass points within kRevisitWithinM of the first pass.
+inline constexpr double kRevisitRadiusM = 5.0;
+inline constexpr double kRevisitMinSeparationS = 30.0;
+inline constexpr double kRevisitMaxHeadingDeg = 45.0;
+inline constexpr double kRevisitWithinM = 0.2;
+inline constexpr double kRevisitTargetFraction = 0.95;
+
+// report.json's map "revisits"; `pose_of`: the poses the map is built with.
+nlohmann::json revisitReport(const MapRecorder& recorder, const mapping::PoseLookup& pose_of);
+
 }  // namespace gvio::run

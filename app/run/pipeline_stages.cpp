@@ -109,14 +109,17 @@ void runMapStage(RunState& s) {
     return;
   }
   const Trajectory* poses = s.final_trajectory.empty() ? nullptr : &s.final_trajectory;
+  // Before the build, which frees the keyframes' dense points.
   nlohmann::json two_pass_report;
-  if (s.request.two_pass) {  // before the build, which frees the keyframes' dense points
+  if (s.request.two_pass) {
     two_pass_report = twoPassReport(*s.map_recorder, mapPoses(*s.map_recorder, poses),
                                     *s.request.two_pass, s.dataset.frames.front().t_ns);
   }
+  const nlohmann::json revisits = revisitReport(*s.map_recorder, mapPoses(*s.map_recorder, poses));
   const MapRunResult map = buildAndWriteMap(*s.map_recorder, poses, s.georeferenced, s.request.out);
   s.map_report = mapReport(*s.map_recorder, map);
   if (s.request.two_pass) s.map_report["two_pass"] = two_pass_report;
+  s.map_report["revisits"] = revisits;
   s.map_report["las"] = map.las;
   s.map_recorder.reset();
   spdlog::info("map ({}): {} landmarks, {} dense points, {} occupied voxels", map.frame,

@@ -265,6 +265,11 @@ TEST(MappingConsistency, TwoPassAgreementOnNoisyPlaneSamplings) {
   EXPECT_EQ(twoPassAgreement(pass1, pass2_offset, 0.1).n_overlap, 0u);
   EXPECT_EQ(twoPassAgreement(MapCloud(), pass2, 1.0).n_overlap, 0u);
   EXPECT_THROW(std::ignore = twoPassAgreement(pass1, pass2, 0.0), InvalidInput);
+  // The share within a bound: all of the aligned pass but the band just past pass 1's edge
+  // (x in 10.2..11 of the overlap's 0..11 m: 7 %), none of the 0.3 m offset one.
+  EXPECT_NEAR(twoPassAgreement(pass1, pass2, 1.0, 0.2).fraction_within, 1.0 - 0.8 / 11.0, 0.01);
+  EXPECT_LT(twoPassAgreement(pass1, pass2_offset, 1.0, 0.2).fraction_within, 0.01);
+  EXPECT_EQ(twoPassAgreement(pass1, pass2, 1.0, 0.2).within_m, 0.2);
 }
 
 }  // namespace
