@@ -86,6 +86,7 @@ std::optional<GnssRunResult> fuseGnss(const io::Dataset& ds, const Trajectory& v
   } else {
     r.fused_online = fusion.fusedTrajectory();
     r.fused_covariance = fusion.smoothedCovariance();
+    r.smoothed = true;
   }
   r.T_enu_w = fusion.T_enu_w();
   if (!r.T_enu_w) {
@@ -179,7 +180,7 @@ nlohmann::json gnssReport(const GnssRunResult& r, std::size_t fixes_in_dataset) 
             {"outside_drive", r.screening.outside_drive},
             {"out_of_order", r.screening.out_of_order}}},
           {"registered", r.T_enu_w.has_value()},
-          {"smoothed", !r.fused_online.empty()},
+          {"smoothed", r.smoothed},
           {"ms_smoothing", r.stats.ms_smoothing},
           {"position_sigma_m", positionSigma(r.fused_covariance)},
           {"poses_before_registration", r.stats.poses_before_alignment},

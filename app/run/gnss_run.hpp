@@ -23,7 +23,8 @@ struct GnssRunResult {
   // T_enu_b, empty when the registration to ENU never succeeded: the smoothed trajectory when the
   // smoothing pass ran (graph mode), else the causal one.
   Trajectory fused;
-  Trajectory fused_online;  // the causal T_enu_b, only when `fused` is the smoothed one
+  Trajectory fused_online;  // the causal T_enu_b, when `fused` is not the causal one
+  bool smoothed = false;    // the smoothing pass ran (graph mode)
   std::vector<fusion::PoseCovariance> fused_covariance;  // per smoothed pose, may be empty
   std::optional<Eigen::Isometry3d> T_enu_w;
 };

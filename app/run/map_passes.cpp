@@ -9,6 +9,7 @@
 #include <pcl/point_types.h>
 
 #include <algorithm>
+#include <chrono>
 #include <optional>
 
 #include "mapping/consistency.hpp"
@@ -90,6 +91,7 @@ Revisits findRevisits(const MapRecorder& recorder, const mapping::PoseLookup& po
 }  // namespace
 
 nlohmann::json revisitReport(const MapRecorder& recorder, const mapping::PoseLookup& pose_of) {
+  const auto start = std::chrono::steady_clock::now();
   const Revisits revisits = findRevisits(recorder, pose_of);
   std::vector<double> d;
   std::size_t n1 = 0, n2 = 0, second = 0;
@@ -121,7 +123,9 @@ nlohmann::json revisitReport(const MapRecorder& recorder, const mapping::PoseLoo
       {"median_m", a.median_m},
       {"p90_m", a.p90_m},
       {"target_fraction", kRevisitTargetFraction},
-      {"meets_target", a.n_overlap > 0 && a.fraction_within >= kRevisitTargetFraction}};
+      {"meets_target", a.n_overlap > 0 && a.fraction_within >= kRevisitTargetFraction},
+      {"ms", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                 .count()}};
   if (a.n_overlap > 0) {
     spdlog::info(
         "map at revisits: {} second-pass keyframes in {} runs, {:.1f} % of {} overlapping points "

@@ -86,7 +86,9 @@ void runLoopStage(RunState& s) {
   s.georeferenced = s.loops->frame == "enu";
   if (s.georeferenced && s.gnss) {
     // trajectory.tum is now the loop-closed one; the smoother's covariances describe the poses
-    // before the loops, so they are not written with it.
+    // before the loops, so they are not written with it. In kf mode the filter's causal output
+    // stays available as trajectory_online.tum (graph mode already keeps its causal one there).
+    if (s.gnss->fused_online.empty()) s.gnss->fused_online = s.gnss->fused;
     s.gnss->fused = s.loops->trajectory;
     s.gnss->fused_covariance.clear();
   }

@@ -108,8 +108,9 @@ json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportCon
     if (e.ape && online && online->ape) {
       report["evaluation_fused"]["ape_none_online"] = statsJson(*online->ape);
       report["evaluation_fused"]["trajectory"] =
-          "ape_none: trajectory.tum (smoothed over all fixes); ape_none_online: "
-          "trajectory_online.tum (causal)";
+          "ape_none: trajectory.tum (the final trajectory: loop-closed when loops.applied, else "
+          "smoothed over all fixes in graph mode); ape_none_online: trajectory_online.tum "
+          "(causal)";
     }
   }
   return report;

@@ -1,18 +1,22 @@
 #!/usr/bin/env bash
-# End-to-end benchmark (issues 6 and 7): simulates the full KITTI-00 drive once (cached, SPP-grade
-# GNSS), runs `gvio run` per mode, evaluates the VIO with `gvio eval` (SE(3) alignment: APE RMSE,
-# RPE per 100 m), the fused trajectory with no alignment against the ENU truth, and prints a table
-# with ms/frame per stage (mean, p95), GNSS cost per fix and peak RSS from report.json.
-# A mode is VIO_MODE:GNSS (GNSS off|kf|graph). A benchmark, not a test: nothing asserts a timing.
+# End-to-end benchmark (issues 6, 7, 8, 15): simulates the full KITTI-00 drive once (cached,
+# SPP-grade GNSS), runs `gvio run` per mode, evaluates the VIO with `gvio eval` (SE(3) alignment:
+# APE RMSE, RPE per 100 m), the final trajectory (trajectory.tum: loop-closed, fused) with no
+# alignment against the ENU truth (SE(3) without GNSS) and its revisit consistency
+# (`gvio eval --revisits 5`), and prints tables with ms/frame per stage (mean, p95), GNSS cost per
+# fix, the map stage, loop closure and peak RSS from report.json.
+# A mode is VIO_MODE:GNSS[:noloops] (GNSS off|kf|graph; noloops: loops.enabled=false, today's
+# behaviour before loop closure). BENCH_SET adds --set options to every run. A benchmark, not a
+# test: nothing asserts a timing.
 #
 #   tests/bench/vio_kitti00.sh                         # all modes, full drive
-#   BENCH_MODES="stereo-imu:graph" BENCH_SECONDS=60 tests/bench/vio_kitti00.sh
+#   BENCH_MODES="stereo-imu:graph stereo-imu:graph:noloops" BENCH_SECONDS=60 tests/bench/vio_kitti00.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 BUILD_DIR="${BUILD_DIR:-build}"
 GVIO="$BUILD_DIR/app/gvio"
 DATA="${GVIO_SHARED_DATA:-../shared/data}/kitti00"
-MODES="${BENCH_MODES:-stereo-imu:graph stereo-imu:kf stereo:off mono-imu:off}"
+MODES="${BENCH_MODES:-stereo-imu:graph stereo-imu:graph:noloops stereo-imu:off stereo-imu:off:noloops stereo-imu:kf stereo:off mono-imu:off}"
 SECONDS_ARG=()
 TAG="full"
 if [ -n "${BENCH_SECONDS:-}" ]; then
@@ -40,13 +44,27 @@ mkdir -p "$OUT"
 # The simulator's ENU origin and antenna lever arm (its defaults), so that the fused trajectory can
 # be compared with groundtruth.tum without any alignment.
 GEO=(--set "fusion.origin=48.98253,8.39035,116.4" --set "fusion.lever_arm_b=[0,0,0.8]")
+EXTRA=()
+for kv in ${BENCH_SET:-}; do EXTRA+=(--set "$kv"); done
 for mode in $MODES; do
-  run="$OUT/${mode/:/_}"
-  "$GVIO" run --dataset "$CACHE" --gnss "${mode#*:}" --set "vio.mode=${mode%%:*}" "${GEO[@]}" \
-    --out "$run" --no-progress
+  run="$OUT/${mode//:/_}"
+  IFS=: read -r vio gnss loops <<< "$mode"
+  LOOPS=()
+  [ "${loops:-}" = "noloops" ] && LOOPS=(--set loops.enabled=false)
+  "$GVIO" run --dataset "$CACHE" --gnss "$gnss" --set "vio.mode=$vio" "${GEO[@]}" "${LOOPS[@]}" \
+    "${EXTRA[@]}" --out "$run" --no-progress
   if [ -s "$run/trajectory_vio.tum" ]; then
     "$GVIO" eval --ref "$CACHE/groundtruth.tum" --est "$run/trajectory_vio.tum" --align se3 \
       --rpe-delta 100 --rpe-unit m --json "$run/eval.json" > /dev/null
+  fi
+  # The run's final trajectory: in ENU (no alignment) when fused, else the VIO world (SE(3)).
+  final="$run/trajectory.tum"
+  [ -s "$final" ] || final="$run/trajectory_vio.tum"
+  align=se3
+  [ -f "$run/georef.json" ] && align=none
+  if [ -s "$final" ]; then
+    "$GVIO" eval --ref "$CACHE/groundtruth.tum" --est "$final" --align "$align" --revisits 5 \
+      --json "$run/eval_final.json" > /dev/null
   fi
 done
 
@@ -102,4 +120,37 @@ for mode in modes:
           f'| {k["dense_depth"]["mean"] + k["octomap"]["mean"]:.1f} | {m["ms_build"] / 1e3:.1f} '
           f'| {m["dense_points"]} | {m["occupied_voxels"]} '
           f'| {m["store_mb"]:.0f} / {m["octree_mb"]:.0f} | {rep["peak_rss_mb"]:.0f} |')
+
+# Loop closure (issue 15): the final trajectory's APE and revisit consistency, the map at revisits,
+# what detection found and what it cost, the global graph.
+print()
+print("| mode | final APE RMSE (m) | revisits 5 m median / p95 (m) | map at revisits: within 0.2 m "
+      "| loops verified / accepted / kept | detection ms per keyframe mean / p95 "
+      "| features ms per keyframe mean | global solve (s), rounds, converged |")
+print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+for mode in modes:
+    run = os.path.join(out, mode.replace(":", "_"))
+    rep = json.load(open(os.path.join(run, "report.json")))
+    final_path = os.path.join(run, "eval_final.json")
+    ape = rev = "-"
+    if os.path.exists(final_path):
+        ev = json.load(open(final_path))
+        ape = f'{ev["ape"]["rmse"]:.3f}' + (" (SE3)" if not os.path.exists(
+            os.path.join(run, "georef.json")) else "")
+        r = ev.get("revisits", {})
+        if r.get("n"):
+            rev = f'{r["median"]:.3f} / {r["p95"]:.3f}'
+    mr = rep.get("map", {}).get("revisits")
+    map_rev = f'{100 * mr["fraction_within"]:.1f} %' if mr and mr.get("overlap_points") else "-"
+    lp = rep.get("loops")
+    if lp and "graph" in lp:
+        g = lp["graph"]
+        det = lp["ms_detection_per_keyframe"]
+        solve = (f'{g["ms_solve"] / 1e3:.2f}, {g["rounds"]}, {"yes" if g["converged"] else "NO"}'
+                 if g.get("solved") else "not needed (no loop)")
+        print(f'| {mode} | {ape} | {rev} | {map_rev} | {lp["verified"]} / {lp["accepted"]} / '
+              f'{g["active_loops"]} | {det["mean"]:.2f} / {det["p95"]:.2f} '
+              f'| {lp["ms_features_per_keyframe"]["mean"]:.2f} | {solve} |')
+    else:
+        print(f"| {mode} | {ape} | {rev} | {map_rev} | off | - | - | - |")
 PY

@@ -185,6 +185,10 @@ TEST_F(CliLoops, WithSppGnssLoopsImproveTheFusedTrajectoryInEveryGnssMode) {
     EXPECT_LT(pair_error, 0.05) << mode;
     EXPECT_LT(pair_error, 0.25 * pair_error_without) << mode;
     EXPECT_TRUE(fs::exists(runDir(mode) / "trajectory_lla.csv"));
+    // The causal output (the paper's filter in kf mode) stays beside the loop-closed one.
+    EXPECT_TRUE(fs::exists(runDir(mode) / "trajectory_online.tum"));
+    EXPECT_EQ(r["gnss"]["smoothed"].get<bool>(), std::string(mode) == "graph");
+    EXPECT_TRUE(r["loops"]["applied"].get<bool>());
   }
 }
 
