@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 
+#include <Eigen/Cholesky>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/features2d.hpp>
@@ -229,6 +230,13 @@ LoopMeasurement verifyLoop(const LoopKeyframe& query, const LoopKeyframe& candid
     return m;
   }
   toBodyFrames(T_q_c, pnpCovariance(c, inliers, T_q_c, camera, err), camera, m);
+  // Degenerate geometry (inliers on a line, all at one depth far away) leaves the pose
+  // unconstrained in some direction: no usable loop, whatever the inlier count.
+  const Eigen::LLT<Matrix6d> llt(m.covariance);
+  if (!m.covariance.allFinite() || llt.info() != Eigen::Success) {
+    m.check = LoopCheck::kPnpFailed;
+    return m;
+  }
   m.check = LoopCheck::kOk;
   return m;
 }
