@@ -31,7 +31,7 @@ struct GlobalGraphConfig {
   // horizontal sigma (0: no bias state) and correlation time.
   double bias_ratio = 0.5;
   double bias_tau_s = 60.0;
-  bool tilt = true;                // tilt factors (only when the VIO had an IMU)
+  bool tilt = true;               // tilt factors (only when the VIO had an IMU)
   double tilt_sigma_rad = 0.017;  // their 1 sigma (1 deg)
   // A loop whose error against the solution exceeds this chi-square (6 DoF; 99.9 %: 22.46) is
   // switched off.
