@@ -40,7 +40,9 @@ void buildingRow(Street& street, Rng& rng, double side, const RowSpec& spec, dou
     const double height = spec.height_lo + (spec.height_hi - spec.height_lo) * u * u;
     const double front = rng.uniform(spec.lateral_lo, spec.lateral_hi);
     double used = 0.25 * width;  // how far the row moves on when nothing fits
+    const bool skip = builtBefore(street, stationAt(street.stations, s));
     for (const double fraction : {1.0, 0.5, 0.25}) {
+      if (skip) break;
       const double wide = fraction * width;
       if (fraction < 1.0 && wide < 6.0) break;
       const Station st = stationAt(street.stations, s + wide / 2.0);

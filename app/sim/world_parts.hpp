@@ -1,8 +1,9 @@
 #pragma once
 // Internals of buildWorld shared by world.cpp (route), world_surfaces.cpp (road, sidewalks,
-// ground), world_props.cpp (buildings, trees, poles, cars) and world_objects.cpp (their layout):
-// the resampled centre line, spatial hashes of route points (clearance, shared height field) and
-// of placed footprints, and a mesh builder that batches triangles per texture.
+// ground), world_props.cpp (buildings, trees, poles, cars), world_objects.cpp (the street's
+// layout) and the other styles' layouts (world_styles.cpp, world_repetitive.cpp): the resampled
+// centre line, spatial hashes of route points (clearance, shared height field) and of placed
+// footprints, and a mesh builder that batches triangles per texture.
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
@@ -142,6 +143,18 @@ struct Street {
 
 constexpr double kCurbHeight = 0.15;  // sidewalk above the road (m)
 
+// The style's textures (textures_styles.cpp): sparse_texture swaps the library's textures in place
+// for plain low-contrast ones; repetitive fits the ground's repeat to the period.
+void restyleTextures(TextureLibrary& lib, WorldStyle style, std::uint64_t seed, int size_px);
+
+// An earlier pass of the route drove along this station's street (a route point within the road
+// half width, from further back than this pass's own neighbourhood): that pass has built it.
+[[nodiscard]] bool revisited(const Street& street, const Station& st);
+// Objects at this station are the earlier pass's business: in every style but the street (which
+// keeps the world it always had, where a later pass fills gaps the first one left), a street is
+// furnished by the first pass along it only, so more laps do not make it denser.
+[[nodiscard]] bool builtBefore(const Street& street, const Station& st);
+
 void addStreetSurfaces(Street& street, std::uint64_t seed);  // road, paint, sidewalks, ground
 
 // Object primitives (world_props.cpp), shared by the layouts.
@@ -184,5 +197,11 @@ void buildingRow(Street& street, Rng& rng, double side, const RowSpec& spec, dou
 void endWalls(Street& street, Rng& rng);  // facades across the street beyond both ends
 void addBuildings(Street& street, std::uint64_t seed);
 void addStreetFurniture(Street& street, std::uint64_t seed);  // trees, poles, parked cars
+
+// The other styles' layouts (world_styles.cpp, world_repetitive.cpp).
+void addOpenRoadObjects(Street& street, std::uint64_t seed);
+void addSparseObjects(Street& street, std::uint64_t seed);
+void addVegetationObjects(Street& street, std::uint64_t seed);
+void addRepetitiveObjects(Street& street, std::uint64_t seed);
 
 }  // namespace gvio::sim::detail

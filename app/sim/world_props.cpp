@@ -78,6 +78,7 @@ void treeMesh(Street& street, Rng& rng, const Eigen::Vector2d& c, const Eigen::V
 }
 
 void tree(Street& street, Rng& rng, const Station& st, double side) {
+  if (builtBefore(street, st)) return;
   const double w = street.options.road_half_width_m, sw = street.options.sidewalk_width_m;
   const double r = rng.uniform(1.4, 2.6), trunk_h = rng.uniform(2.2, 3.5);
   const double lateral = std::max(w + sw + rng.uniform(0.4, 1.5), roadClearance(street) + 1.2 * r);
@@ -88,6 +89,7 @@ void tree(Street& street, Rng& rng, const Station& st, double side) {
 
 void treeAt(Street& street, Rng& rng, const Station& st, double side, double lateral,
             double clearance) {
+  if (builtBefore(street, st)) return;
   const double r = rng.uniform(1.4, 2.8), trunk_h = rng.uniform(2.0, 4.0);
   const Footprint crown = along(st, side, lateral, 1.2 * r, 1.2 * r);
   if (!claim(street, crown, clearance, 0.1)) return;
@@ -99,7 +101,7 @@ void hedge(Street& street, Rng& rng, double s, double side) {
   const double length = rng.uniform(3.0, 10.0), depth = rng.uniform(0.6, 1.0);
   const Station st = stationAt(street.stations, s + length / 2.0);
   const Footprint f = along(st, side, w + sw + 0.2 + depth / 2.0, length / 2.0, depth / 2.0);
-  if (!claim(street, f, roadClearance(street), 0.1)) return;
+  if (builtBefore(street, st) || !claim(street, f, roadClearance(street), 0.1)) return;
   const TextureLibrary& lib = street.lib;
   const BoxSkin leaves{tiled(lib, lib.foliage), tiled(lib, lib.foliage), tiled(lib, lib.foliage)};
   const double z = street.route.roadHeight(f.c) + kCurbHeight;
@@ -109,6 +111,7 @@ void hedge(Street& street, Rng& rng, double s, double side) {
 // Street lamp (mast and a head reaching towards the road) or a traffic sign. The claimed `reach`
 // covers both: its inner edge stays 0.05 m outside the road clearance.
 bool claimPole(Street& street, const Station& st, double side) {
+  if (builtBefore(street, st)) return false;
   const double lateral = roadClearance(street) + 0.8;
   return claim(street, along(st, side, lateral - 0.3, 0.35, 0.45), roadClearance(street), 0.1);
 }
