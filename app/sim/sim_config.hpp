@@ -2,6 +2,7 @@
 // Simulator settings (YAML section `sim:`), plain struct with defaults. Per-run choices that users
 // vary every time (duration, GNSS grade, outages, seed, output format) are CLI flags instead.
 #include <Eigen/Core>
+#include <string>
 
 #include "odometry/measurements.hpp"
 
@@ -28,6 +29,7 @@ struct SimConfig {
   double knot_spacing_s = 0.25;    // trajectory spline
   double smoothing = 1e-2;
   int texture_size_px = 512;
+  std::string world_style = "street";  // sim/world.hpp: WorldStyle (--world-style overrides)
 
   void validate() const;  // throws InvalidInput naming the key
 };

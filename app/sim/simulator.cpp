@@ -189,6 +189,7 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
   const std::vector<Eigen::Vector3d> route = routeOf(traj, t1, summary.path_length_m);
   WorldOptions world_opt;
   world_opt.seed = mixSeed(r.seed, 3);
+  world_opt.style = *parseWorldStyle(config.world_style);  // validated
   world_opt.texture_size_px = config.texture_size_px;
   const World world = buildWorld(route, world_opt);
   summary.world_triangles = world.triangles;

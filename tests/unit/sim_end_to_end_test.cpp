@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <yaml-cpp/yaml.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
@@ -80,11 +81,12 @@ TEST_F(SimEndToEnd, SameSeedIsByteIdentical) {
                           traj, (dir_->path() / "b").string()))
           .exit_code,
       0);
-  ASSERT_EQ(
-      runGvio(fmt::format("simulate --trajectory {} --seconds 1 --seed 7 --out {} --no-progress",
-                          traj, (dir_->path() / "c").string()))
-          .exit_code,
-      0);
+  // The default world style named explicitly is the same drive.
+  ASSERT_EQ(runGvio(fmt::format("simulate --trajectory {} --seconds 1 --seed 7 --world-style "
+                                "street --out {} --no-progress",
+                                traj, (dir_->path() / "c").string()))
+                .exit_code,
+            0);
   ASSERT_EQ(
       runGvio(fmt::format("simulate --trajectory {} --seconds 1 --seed 8 --out {} --no-progress",
                           traj, (dir_->path() / "d").string()))
@@ -243,6 +245,22 @@ TEST_F(SimEndToEnd, MotionBlurAndExposureChange) {
   EXPECT_GT(cv::mean(bright)[0], 1.08 * cv::mean(plain)[0]);
 }
 
+// --world-style (or sim.world_style) picks the world: recorded in sim.yaml, another world.ply.
+TEST_F(SimEndToEnd, WorldStyleReachesTheWorld) {
+  const std::string traj = (dir_->path() / "drive.tum").string();
+  for (const char* style : {"street", "open_road"}) {
+    const auto r = runGvio(fmt::format(
+        "simulate --trajectory {} --seconds 0.3 --seed 7 --world-style {} --out {} --no-progress",
+        traj, style, (dir_->path() / style).string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_THAT(r.out, HasSubstr(fmt::format("{} world", style)));
+    const YAML::Node yaml = YAML::LoadFile((dir_->path() / style / "sim.yaml").string());
+    EXPECT_EQ(yaml["config"]["sim"]["world_style"].as<std::string>(), style);
+  }
+  EXPECT_NE(readText(dir_->path() / "street" / "world" / "world.ply"),
+            readText(dir_->path() / "open_road" / "world" / "world.ply"));
+}
+
 TEST_F(SimEndToEnd, BadInputIsOneLineExit2) {
   const fs::path d = dir_->path();
   writeText(d / "three.tum", "0 0 0 0 0 0 0 1\n0.1 1 0 0 0 0 0 1\n0.2 2 0 0 0 0 0 1\n");
@@ -260,6 +278,11 @@ TEST_F(SimEndToEnd, BadInputIsOneLineExit2) {
        "outside the drive"},
       {"simulate --trajectory " + traj + " --gnss-outage 5 --out " + (d / "x5").string(), "T0:T1"},
       {"simulate --trajectory " + traj + " --seconds 1 --out " + out().string(), "not empty"},
+      {"simulate --trajectory " + traj + " --world-style foo --out " + (d / "x6").string(),
+       "--world-style 'foo'"},
+      {"simulate --trajectory " + traj + " --set sim.world_style=Street --out " +
+           (d / "x7").string(),
+       "sim.world_style"},
   };
   for (const auto& [args, needle] : cases) {
     const auto r = runGvio(args + " --no-progress");
