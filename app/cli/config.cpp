@@ -318,6 +318,8 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("sim.smoothing", c.sim.smoothing),
       integer("sim.texture_size_px", c.sim.texture_size_px),
       text("sim.world_style", c.sim.world_style),
+      number("sim.imu_noise_scale_min", c.sim.imu_noise_scale_min),
+      number("sim.imu_noise_scale_max", c.sim.imu_noise_scale_max),
   };
 }
 

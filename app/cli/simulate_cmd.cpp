@@ -66,6 +66,12 @@ int runSimulate(SimulateCliOptions& o, const CommonOptions& common) {
       "triangles\n",
       s.duration_s, s.path_length_m, s.frames, r.stereo ? "stereo" : "mono", s.imu_samples,
       s.gnss_fixes, config.sim.world_style, s.world_triangles);
+  const ImuNoise& n = s.imu_noise.noise;
+  fmt::print(
+      "IMU noise: acc {:.3g} m/s^2/sqrt(Hz), gyr {:.3g} rad/s/sqrt(Hz), acc walk {:.3g}, gyr "
+      "walk {:.3g} (x {:.3g}, {:.3g}, {:.3g}, {:.3g} of imu.*)\n",
+      n.acc_noise_density, n.gyr_noise_density, n.acc_random_walk, n.gyr_random_walk,
+      s.imu_noise.scale[0], s.imu_noise.scale[1], s.imu_noise.scale[2], s.imu_noise.scale[3]);
   fmt::print(
       "trajectory fit residual: position rms {:.4f} m (max {:.4f}), rotation rms {:.3f} deg (max "
       "{:.3f})\n",

@@ -47,6 +47,10 @@ void SimConfig::validate() const {
     throw InvalidInput(fmt::format("config: sim.world_style must be one of {} (got '{}')",
                                    kWorldStyleNames, world_style));
   }
+  require(imu_noise_scale_min >= 0.01 && imu_noise_scale_min <= 100.0, "imu_noise_scale_min",
+          "in [0.01, 100]", imu_noise_scale_min);
+  require(imu_noise_scale_max >= imu_noise_scale_min && imu_noise_scale_max <= 100.0,
+          "imu_noise_scale_max", "in [sim.imu_noise_scale_min, 100]", imu_noise_scale_max);
 }
 
 }  // namespace gvio::sim
