@@ -5,10 +5,14 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <numbers>
 #include <opencv2/core.hpp>
+#include <sstream>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -195,6 +199,37 @@ inline cv::Mat greyOf(const render::ImageRgba& img) {  // grey textures: R = G =
   cv::extractChannel(
       cv::Mat(img.height, img.width, CV_8UC4, const_cast<std::uint8_t*>(img.rgba.data())), grey, 0);
   return grey;
+}
+
+// KITTI odometry ground truth (cam0 poses; world x right, y down, z forward at the first frame)
+// as camera poses in an ENU-like frame: east = x, north = z, up = -y.
+inline std::vector<Eigen::Isometry3d> kittiCameraPoses(const std::filesystem::path& file) {
+  Eigen::Matrix3d M;
+  M << 1, 0, 0, 0, 0, 1, 0, -1, 0;
+  std::vector<Eigen::Isometry3d> poses;
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream ls(line);
+    Eigen::Matrix<double, 3, 4> m;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 4; ++c) ls >> m(r, c);
+    }
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = M * m.leftCols<3>();
+    T.translation() = M * m.col(3);
+    poses.push_back(T);
+  }
+  return poses;
+}
+
+// Body positions along KITTI 00 (the camera is 1.65 m above the road); empty without the data.
+inline std::vector<Eigen::Vector3d> kitti00Route() {
+  const std::filesystem::path gt = std::string(GVIO_SHARED_DATA_DIR) + "/kitti00/KITTI_00_gt.txt";
+  std::vector<Eigen::Vector3d> route;
+  if (!std::filesystem::exists(gt)) return route;
+  for (const auto& T : kittiCameraPoses(gt))
+    route.push_back(T.translation() - Eigen::Vector3d(0, 0, kCameraHeight - kBodyHeight));
+  return route;
 }
 
 }  // namespace gvio::sim::world_fixture

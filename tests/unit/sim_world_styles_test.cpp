@@ -4,6 +4,7 @@
 // 30 m, vegetation no buildings, repetitive identical buildings every period.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <iostream>
@@ -214,6 +215,32 @@ TEST(SimWorldStyles, RepetitiveBuildingsAreIdenticalEveryPeriod) {
   for (std::size_t i = 1; i < left_x.size(); ++i)
     EXPECT_NEAR(left_x[i] - left_x[i - 1], kRepetitivePeriod_m, 1e-6);
   for (const auto& size : sizes) EXPECT_LT((size - sizes.front()).norm(), 1e-6);
+}
+
+// KITTI 00 (3.7 km, crossing and revisiting its streets) in every style: triangle budget, build
+// time, no object on the road (surfaces follow a blended height field where passes' recorded
+// heights differ, see sim_world_test), no building inside another.
+TEST(SimWorldStyles, Kitti00InEveryStyle) {
+  const auto route = kitti00Route();
+  if (route.empty()) GTEST_SKIP() << "KITTI 00 ground truth not found";
+  const TextureLibrary lib = makeTextureLibrary(1, 64);
+  const std::vector<std::size_t> surfaces{lib.asphalt, lib.marking, lib.paving, lib.curb,
+                                          lib.ground};
+  for (const WorldStyle style : kAllStyles) {
+    if (style == WorldStyle::kStreet) continue;  // sim_world_test's Kitti00Drive
+    WorldOptions o;
+    o.style = style;
+    const auto t0 = std::chrono::steady_clock::now();
+    const World world = buildWorld(route, o);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::cout << "[ kitti 00, " << toString(style) << " ] " << world.triangles
+              << " triangles, built in " << seconds << " s\n";
+    EXPECT_LT(world.triangles, 1500000U);
+    EXPECT_EQ(verticesOnRoad(world, route, 4.5, kBodyHeight, surfaces), 0U) << toString(style);
+    EXPECT_LT(deepestBuildingOverlap(buildingFootprints(world, lib.facade_front)), 0.15)
+        << toString(style);
+  }
 }
 
 }  // namespace

@@ -224,27 +224,6 @@ TEST_F(SimWorldRenderTest, CornersAndKltAlongTheStreet) {
   saveTopDown(world, route, "/tmp/sim_world_topdown.png");
 }
 
-// KITTI odometry ground truth (cam0 poses; world x right, y down, z forward at the first frame)
-// as camera poses in an ENU-like frame: east = x, north = z, up = -y.
-std::vector<Eigen::Isometry3d> kittiCameraPoses(const std::filesystem::path& file) {
-  Eigen::Matrix3d M;
-  M << 1, 0, 0, 0, 0, 1, 0, -1, 0;
-  std::vector<Eigen::Isometry3d> poses;
-  std::ifstream in(file);
-  for (std::string line; std::getline(in, line);) {
-    std::istringstream ls(line);
-    Eigen::Matrix<double, 3, 4> m;
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 4; ++c) ls >> m(r, c);
-    }
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = M * m.leftCols<3>();
-    T.translation() = M * m.col(3);
-    poses.push_back(T);
-  }
-  return poses;
-}
-
 // The real drive (KITTI 00, 3.7 km, crossing and revisiting its streets): triangle budget, build
 // time, a free road, and corners and KLT between consecutive ground-truth frames (10 Hz).
 TEST_F(SimWorldRenderTest, Kitti00Drive) {
