@@ -7,6 +7,7 @@
 #include "cli/app.hpp"
 #include "odometry/error.hpp"
 #include "sim/simulator.hpp"
+#include "sim/world.hpp"
 
 namespace gvio::cli {
 namespace {
@@ -15,7 +16,7 @@ struct SimulateCliOptions {
   sim::SimRequest request;
   std::string format = "kitti-raw", camera = "stereo", gnss = "spp";
   std::vector<std::string> outages;
-  std::optional<std::string> times;
+  std::optional<std::string> times, world_style;
   std::string trajectory, out;
   ConfigOptions config;
 };
@@ -36,7 +37,14 @@ std::pair<double, double> parseOutage(const std::string& text) {
 }
 
 int runSimulate(SimulateCliOptions& o, const CommonOptions& common) {
-  const AppConfig config = o.config.load();
+  AppConfig config = o.config.load();
+  if (o.world_style) {  // checked here, not by CLI11: a bad value is one line, exit 2
+    if (!sim::parseWorldStyle(*o.world_style)) {
+      throw gvio::InvalidInput(fmt::format("--world-style '{}': expected one of {}", *o.world_style,
+                                           sim::kWorldStyleNames));
+    }
+    config.sim.world_style = *o.world_style;
+  }
   sim::SimRequest& r = o.request;
   r.config_yaml = dumpConfigYaml(config);
   r.trajectory = o.trajectory;
@@ -54,10 +62,16 @@ int runSimulate(SimulateCliOptions& o, const CommonOptions& common) {
       });
   if (progress) progress->finish();
   fmt::print(
-      "simulated {:.1f} s, {:.0f} m: {} {} frames, {} IMU samples, {} GNSS fixes, world {} "
+      "simulated {:.1f} s, {:.0f} m: {} {} frames, {} IMU samples, {} GNSS fixes, {} world {} "
       "triangles\n",
       s.duration_s, s.path_length_m, s.frames, r.stereo ? "stereo" : "mono", s.imu_samples,
-      s.gnss_fixes, s.world_triangles);
+      s.gnss_fixes, config.sim.world_style, s.world_triangles);
+  const ImuNoise& n = s.imu_noise.noise;
+  fmt::print(
+      "IMU noise: acc {:.3g} m/s^2/sqrt(Hz), gyr {:.3g} rad/s/sqrt(Hz), acc walk {:.3g}, gyr "
+      "walk {:.3g} (x {:.3g}, {:.3g}, {:.3g}, {:.3g} of imu.*)\n",
+      n.acc_noise_density, n.gyr_noise_density, n.acc_random_walk, n.gyr_random_walk,
+      s.imu_noise.scale[0], s.imu_noise.scale[1], s.imu_noise.scale[2], s.imu_noise.scale[3]);
   fmt::print(
       "trajectory fit residual: position rms {:.4f} m (max {:.4f}), rotation rms {:.3f} deg (max "
       "{:.3f})\n",
@@ -90,6 +104,9 @@ Command addSimulateCommand(CLI::App& app, const CommonOptions& common) {
                   "T0:T1 seconds since the start without fixes (repeatable)")
       ->take_all()
       ->allow_extra_args(false);
+  sub->add_option("--world-style", o->world_style,
+                  "street (default), open_road, sparse_texture, repetitive or vegetation "
+                  "(overrides sim.world_style)");
   sub->add_option("--seed", o->request.seed, "Random seed: same seed, byte-identical output");
   sub->add_option("--out", o->out, "Output folder (must be empty unless --force)")->required();
   sub->add_flag("--force", o->request.force,

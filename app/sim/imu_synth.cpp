@@ -55,6 +55,26 @@ ImuSample truthAt(const ContinuousTrajectory& trajectory, std::int64_t t_ns) {
 
 }  // namespace
 
+ImuNoiseDraw drawImuNoise(const ImuNoise& nominal, double scale_min, double scale_max,
+                          std::uint64_t seed) {
+  if (!(scale_min > 0.0) || !(scale_max >= scale_min) || !std::isfinite(scale_max)) {
+    throw InvalidInput("imu noise draw: needs 0 < scale_min <= scale_max");
+  }
+  ImuNoiseDraw draw;
+  Rng rng(seed);
+  for (double& scale : draw.scale) {
+    scale = scale_min == scale_max
+                ? scale_min
+                : std::exp(rng.uniform(std::log(scale_min), std::log(scale_max)));
+  }
+  draw.noise = nominal;
+  draw.noise.acc_noise_density *= draw.scale[0];
+  draw.noise.gyr_noise_density *= draw.scale[1];
+  draw.noise.acc_random_walk *= draw.scale[2];
+  draw.noise.gyr_random_walk *= draw.scale[3];
+  return draw;
+}
+
 // Discrete-time IMU noise model (Kalibr IMU noise model wiki; Nikolic et al. 2016): white noise
 // sigma_d = sigma_c * sqrt(rate) and bias random walk b_{k+1} = b_k + sigma_bc * sqrt(dt) * n_k,
 // n_k ~ N(0, I); measured = truth + b_k + sigma_d * w_k.

@@ -1,6 +1,7 @@
 #pragma once
 // IMU measurements from a continuous trajectory: specific force f_b = R_w_b^T (a_w - g_w) and body
 // rate, plus white noise and bias random walk (continuous-time densities, discretised at the rate).
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -22,6 +23,17 @@ struct ImuSimOptions {
   Eigen::Vector3d initial_acc_bias = Eigen::Vector3d::Zero();
   Eigen::Vector3d initial_gyr_bias = Eigen::Vector3d::Zero();
 };
+
+// One drive's IMU noise: the nominal densities (imu.*), each times a multiplier drawn
+// log-uniformly in [scale_min, scale_max] (independently, in the order acc noise, gyr noise, acc
+// random walk, gyr random walk), so drives differ from what an estimator is tuned for.
+// scale_min == scale_max: no draw, the multiplier is that value exactly.
+struct ImuNoiseDraw {
+  ImuNoise noise;
+  std::array<double, 4> scale{1.0, 1.0, 1.0, 1.0};
+};
+ImuNoiseDraw drawImuNoise(const ImuNoise& nominal, double scale_min, double scale_max,
+                          std::uint64_t seed);
 
 // Samples [t0, t1] of `trajectory` at the rate; deterministic for a seed.
 std::vector<ImuSimSample> synthesizeImu(const ContinuousTrajectory& trajectory,

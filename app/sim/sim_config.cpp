@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "odometry/error.hpp"
+#include "sim/world.hpp"
 
 namespace gvio::sim {
 namespace {
@@ -42,6 +43,14 @@ void SimConfig::validate() const {
   require(texture_size_px >= 64 && texture_size_px <= 4096 &&
               (texture_size_px & (texture_size_px - 1)) == 0,
           "texture_size_px", "a power of two in [64, 4096]", texture_size_px);
+  if (!parseWorldStyle(world_style)) {
+    throw InvalidInput(fmt::format("config: sim.world_style must be one of {} (got '{}')",
+                                   kWorldStyleNames, world_style));
+  }
+  require(imu_noise_scale_min >= 0.01 && imu_noise_scale_min <= 100.0, "imu_noise_scale_min",
+          "in [0.01, 100]", imu_noise_scale_min);
+  require(imu_noise_scale_max >= imu_noise_scale_min && imu_noise_scale_max <= 100.0,
+          "imu_noise_scale_max", "in [sim.imu_noise_scale_min, 100]", imu_noise_scale_max);
 }
 
 }  // namespace gvio::sim

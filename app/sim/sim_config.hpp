@@ -2,6 +2,7 @@
 // Simulator settings (YAML section `sim:`), plain struct with defaults. Per-run choices that users
 // vary every time (duration, GNSS grade, outages, seed, output format) are CLI flags instead.
 #include <Eigen/Core>
+#include <string>
 
 #include "odometry/measurements.hpp"
 
@@ -28,6 +29,10 @@ struct SimConfig {
   double knot_spacing_s = 0.25;    // trajectory spline
   double smoothing = 1e-2;
   int texture_size_px = 512;
+  std::string world_style = "street";  // sim/world.hpp: WorldStyle (--world-style overrides)
+  // Per-drive IMU noise: each of the four imu.* densities times its own multiplier, drawn
+  // log-uniformly in [min, max] by seed (1, 1: the imu.* values exactly).
+  double imu_noise_scale_min = 1.0, imu_noise_scale_max = 1.0;
 
   void validate() const;  // throws InvalidInput naming the key
 };

@@ -125,6 +125,16 @@ void writeSimYaml(const fs::path& file, const SimRequest& r, const SimSummary& s
   for (const auto& [a, b] : r.outages_s)
     y << YAML::Flow << YAML::BeginSeq << a << b << YAML::EndSeq;
   y << YAML::EndSeq;
+  // The IMU noise the drive has (KITTI's oxts cannot state it; EuRoC's imu0/sensor.yaml does too).
+  const ImuNoise& n = s.imu_noise.noise;
+  y << YAML::Key << "imu_noise" << YAML::Value << YAML::BeginMap;
+  y << YAML::Key << "acc_noise_density" << YAML::Value << n.acc_noise_density;
+  y << YAML::Key << "gyr_noise_density" << YAML::Value << n.gyr_noise_density;
+  y << YAML::Key << "acc_random_walk" << YAML::Value << n.acc_random_walk;
+  y << YAML::Key << "gyr_random_walk" << YAML::Value << n.gyr_random_walk;
+  y << YAML::Key << "scale" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (const double scale : s.imu_noise.scale) y << scale;
+  y << YAML::EndSeq << YAML::EndMap;
   y << YAML::Key << "config" << YAML::Value << YAML::Load(r.config_yaml);
   y << YAML::Key << "result" << YAML::Value << YAML::BeginMap;
   y << YAML::Key << "duration_s" << YAML::Value << s.duration_s;
@@ -167,9 +177,11 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
       summary.fit.rotation_max_deg);
 
   // Truth, IMU and GNSS over [t0, t1].
+  summary.imu_noise = drawImuNoise(imu_noise, config.imu_noise_scale_min,
+                                   config.imu_noise_scale_max, mixSeed(r.seed, 5));
   ImuSimOptions imu_opt;
   imu_opt.rate_hz = config.imu_rate_hz;
-  imu_opt.noise = imu_noise;
+  imu_opt.noise = summary.imu_noise.noise;
   std::vector<ImuSimSample> imu = synthesizeImu(traj, imu_opt, mixSeed(r.seed, 1));
   std::erase_if(imu, [&](const ImuSimSample& s) { return s.measured.t_ns > t1; });
   const fusion::EnuFrame enu({config.origin_lat_deg, config.origin_lon_deg, config.origin_h_m});
@@ -189,6 +201,7 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
   const std::vector<Eigen::Vector3d> route = routeOf(traj, t1, summary.path_length_m);
   WorldOptions world_opt;
   world_opt.seed = mixSeed(r.seed, 3);
+  world_opt.style = *parseWorldStyle(config.world_style);  // validated
   world_opt.texture_size_px = config.texture_size_px;
   const World world = buildWorld(route, world_opt);
   summary.world_triangles = world.triangles;
@@ -235,7 +248,7 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
   } else {
     for (std::size_t c = 0; c < ids.size(); ++c)
       writeEurocCamera(r.out, ids[c], frame_t, K, T_b_c[c], config.camera_rate_hz);
-    writeEurocImu(r.out, imu, imu_noise, config.imu_rate_hz);
+    writeEurocImu(r.out, imu, summary.imu_noise.noise, config.imu_rate_hz);
     writeEurocGnss(r.out, fixes);
     writeEurocTruth(r.out, imu, traj);
   }

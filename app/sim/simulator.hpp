@@ -10,6 +10,7 @@
 
 #include "io/dataset.hpp"
 #include "sim/gnss_synth.hpp"
+#include "sim/imu_synth.hpp"
 #include "sim/sim_config.hpp"
 #include "sim/trajectory_fit.hpp"
 
@@ -34,11 +35,13 @@ struct SimSummary {
   std::size_t frames = 0, imu_samples = 0, gnss_fixes = 0, world_triangles = 0;
   double duration_s = 0.0, path_length_m = 0.0;
   FitReport fit;
-  std::string egl;  // EGL path and renderer used
+  ImuNoiseDraw imu_noise;  // the drive's IMU noise (sim.imu_noise_scale_*)
+  std::string egl;         // EGL path and renderer used
 };
 
 using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
 
+// `imu_noise` is the nominal noise (imu.*), scaled per drive as sim.imu_noise_scale_* say.
 // Throws InvalidInput/InputError for bad requests (unreadable trajectory, < 4 poses, outage
 // outside the drive, non-empty output without force, ...).
 SimSummary simulate(const SimRequest& request, const SimConfig& config, const ImuNoise& imu_noise,

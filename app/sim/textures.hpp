@@ -47,6 +47,13 @@ FacadeTextures facadeTextures(FacadeMaterial material, int size_px, std::uint64_
 ProceduralTexture carBodyTexture(int size_px, std::uint64_t seed, double paint_grey);
 ProceduralTexture carCabinTexture(int size_px, std::uint64_t seed);
 
+// Plain, low-contrast surfaces (the sparse_texture world): soft shading, a faint grain, no corners.
+ProceduralTexture plainAsphaltTexture(int size_px, std::uint64_t seed);
+ProceduralTexture plainConcreteTexture(int size_px, std::uint64_t seed, double tone,
+                                       const Eigen::Vector2d& tile_m);
+ProceduralTexture plainGroundTexture(int size_px, std::uint64_t seed);
+FacadeTextures plainWallTextures(int size_px, std::uint64_t seed, double tone);  // no windows
+
 // Every texture the world uses, in Scene::textures order, with indices by role.
 struct TextureLibrary {
   std::vector<render::Texture> textures;

@@ -1,9 +1,10 @@
 // buildWorld: the route cleaned, indexed (clearance and the shared height field) and resampled
-// into stations every ~2 m, extended past its ends; then street surfaces (world_surfaces.cpp),
-// buildings and street furniture (world_objects.cpp) along it.
+// into stations every ~2 m, extended past its ends; then street surfaces (world_surfaces.cpp) and
+// the style's objects along it (world_objects.cpp, world_styles.cpp, world_repetitive.cpp).
 #include "sim/world.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <utility>
 
@@ -15,6 +16,14 @@ namespace {
 
 using detail::Station;
 using detail::Street;
+
+constexpr std::array<std::pair<std::string_view, WorldStyle>, 5> kStyles{{
+    {"street", WorldStyle::kStreet},
+    {"open_road", WorldStyle::kOpenRoad},
+    {"sparse_texture", WorldStyle::kSparseTexture},
+    {"repetitive", WorldStyle::kRepetitive},
+    {"vegetation", WorldStyle::kVegetation},
+}};
 
 constexpr double kStationSpacing = 2.0;  // m
 constexpr double kExtension = 60.0;      // street continues this far past the route ends (m)
@@ -119,12 +128,64 @@ void checkOptions(const WorldOptions& o) {
         "body height");
 }
 
+void addObjects(Street& street, std::uint64_t seed) {
+  switch (street.options.style) {
+    case WorldStyle::kStreet:
+      detail::addBuildings(street, seed);
+      detail::addStreetFurniture(street, seed);
+      break;
+    case WorldStyle::kOpenRoad:
+      detail::addOpenRoadObjects(street, seed);
+      break;
+    case WorldStyle::kSparseTexture:
+      detail::addSparseObjects(street, seed);
+      break;
+    case WorldStyle::kRepetitive:
+      detail::addRepetitiveObjects(street, seed);
+      break;
+    case WorldStyle::kVegetation:
+      detail::addVegetationObjects(street, seed);
+      break;
+  }
+}
+
 }  // namespace
+
+std::optional<WorldStyle> parseWorldStyle(std::string_view name) {
+  for (const auto& [text, style] : kStyles) {
+    if (text == name) return style;
+  }
+  return std::nullopt;
+}
+
+const char* toString(WorldStyle style) {
+  for (const auto& [text, s] : kStyles) {
+    if (s == style) return text.data();
+  }
+  return "street";
+}
+
+namespace detail {
+
+bool revisited(const Street& street, const Station& st) {
+  const double w = street.options.road_half_width_m;
+  for (const auto& r : street.route.near(st.p, w)) {
+    if (r.s < st.s - (3.0 * w + 10.0)) return true;  // beyond this pass's own neighbourhood
+  }
+  return false;
+}
+
+bool builtBefore(const Street& street, const Station& st) {
+  return street.options.style != WorldStyle::kStreet && revisited(street, st);
+}
+
+}  // namespace detail
 
 World buildWorld(const std::vector<Eigen::Vector3d>& route_w, const WorldOptions& options) {
   checkOptions(options);
   const Polyline route = cleanRoute(route_w);
   TextureLibrary lib = makeTextureLibrary(options.seed, options.texture_size_px);
+  detail::restyleTextures(lib, options.style, options.seed, options.texture_size_px);
   Street street{.options = options,
                 .lib = lib,
                 .stations = resample(route, options.body_height_m),
@@ -136,8 +197,7 @@ World buildWorld(const std::vector<Eigen::Vector3d>& route_w, const WorldOptions
   // Stations (and what stands along them) sit on the height field shared by all passes.
   for (auto& st : street.stations) st.z_road = street.route.roadHeight(st.p);
   detail::addStreetSurfaces(street, options.seed);
-  detail::addBuildings(street, options.seed);
-  detail::addStreetFurniture(street, options.seed);
+  addObjects(street, options.seed);
   World world;
   world.triangles = street.mesh.triangles();
   world.scene.meshes = street.mesh.take();

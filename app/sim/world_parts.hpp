@@ -1,8 +1,9 @@
 #pragma once
 // Internals of buildWorld shared by world.cpp (route), world_surfaces.cpp (road, sidewalks,
-// ground) and world_objects.cpp (buildings, trees, poles, cars): the resampled centre line,
-// spatial hashes of route points (clearance, shared height field) and of placed footprints, and a
-// mesh builder that batches triangles per texture.
+// ground), world_props.cpp (buildings, trees, poles, cars), world_objects.cpp (the street's
+// layout) and the other styles' layouts (world_styles.cpp, world_repetitive.cpp): the resampled
+// centre line, spatial hashes of route points (clearance, shared height field) and of placed
+// footprints, and a mesh builder that batches triangles per texture.
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
@@ -142,8 +143,65 @@ struct Street {
 
 constexpr double kCurbHeight = 0.15;  // sidewalk above the road (m)
 
+// The style's textures (textures_styles.cpp): sparse_texture swaps the library's textures in place
+// for plain low-contrast ones; repetitive fits the ground's repeat to the period.
+void restyleTextures(TextureLibrary& lib, WorldStyle style, std::uint64_t seed, int size_px);
+
+// An earlier pass of the route drove along this station's street (a route point within the road
+// half width, from further back than this pass's own neighbourhood): that pass has built it.
+[[nodiscard]] bool revisited(const Street& street, const Station& st);
+// Objects at this station are the earlier pass's business: in every style but the street (which
+// keeps the world it always had, where a later pass fills gaps the first one left), a street is
+// furnished by the first pass along it only, so more laps do not make it denser.
+[[nodiscard]] bool builtBefore(const Street& street, const Station& st);
+
 void addStreetSurfaces(Street& street, std::uint64_t seed);  // road, paint, sidewalks, ground
+
+// Object primitives (world_props.cpp), shared by the layouts.
+[[nodiscard]] double roadClearance(const Street& street);      // anything above the road surface
+[[nodiscard]] double sidewalkClearance(const Street& street);  // buildings: behind the sidewalk
+// Places f if it keeps `clearance` from the route and does not overlap what is placed (more than
+// -margin when margin is negative: row buildings may touch).
+bool claim(Street& street, const Footprint& f, double clearance, double margin);
+Footprint along(const Station& st, double side, double lateral, double half_l, double half_w);
+struct BuildingSkin {
+  std::size_t style = 0;               // index into the library's facade styles
+  double u_front = 0.0, u_side = 0.0;  // texture offsets of the long and short walls
+  double cornice_m = 0.45;
+};
+BuildingSkin randomSkin(const TextureLibrary& lib, Rng& rng);
+void buildingMesh(Street& street, const Footprint& f, double height, const BuildingSkin& skin);
+void buildingMesh(Street& street, Rng& rng, const Footprint& f, double height);  // random skin
+// Trunk and crown of radius r at c; `axis` orients the trunk.
+void treeMesh(Street& street, Rng& rng, const Eigen::Vector2d& c, const Eigen::Vector2d& axis,
+              double r, double trunk_h);
+void tree(Street& street, Rng& rng, const Station& st, double side);  // by the sidewalk
+// A random tree with its crown centred `lateral` from the centre line, if it fits.
+void treeAt(Street& street, Rng& rng, const Station& st, double side, double lateral,
+            double clearance);
+void hedge(Street& street, Rng& rng, double s, double side);
+void pole(Street& street, Rng& rng, const Station& st, double side);  // lamp or sign
+bool claimPole(Street& street, const Station& st, double side);
+void poleMesh(Street& street, const Station& st, double side, bool lamp, double height);
+void car(Street& street, Rng& rng, double s, double side);
+
+// The street's layout (world_objects.cpp).
+struct RowSpec {
+  double lateral_lo, lateral_hi;  // front face from the centre line (m)
+  double width_lo, width_hi, depth_lo, depth_hi, height_lo, height_hi;
+  double gap_chance, gap_hi;  // chance of a gap between buildings, its largest size
+  double margin;              // overlap allowance against placed footprints
+};
+// One row of buildings along one side, each keeping `clearance` from the route.
+void buildingRow(Street& street, Rng& rng, double side, const RowSpec& spec, double clearance);
+void endWalls(Street& street, Rng& rng);  // facades across the street beyond both ends
 void addBuildings(Street& street, std::uint64_t seed);
 void addStreetFurniture(Street& street, std::uint64_t seed);  // trees, poles, parked cars
+
+// The other styles' layouts (world_styles.cpp, world_repetitive.cpp).
+void addOpenRoadObjects(Street& street, std::uint64_t seed);
+void addSparseObjects(Street& street, std::uint64_t seed);
+void addVegetationObjects(Street& street, std::uint64_t seed);
+void addRepetitiveObjects(Street& street, std::uint64_t seed);
 
 }  // namespace gvio::sim::detail

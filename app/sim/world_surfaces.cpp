@@ -3,6 +3,7 @@
 // revisits itself, surfaces are layered so nothing z-fights: every vertex lies on one shared
 // height field, ground below the road, asphalt and ground mapped in world coordinates (two passes
 // draw the same texels), sidewalks and paint dropped where they would lie on another pass's road.
+// The world style varies the layout (SurfaceSpec); `street` is the reference.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -16,7 +17,51 @@ namespace {
 constexpr double kGroundDrop = 0.06;   // ground below the road: the road wins at crossings
 constexpr double kMarkingLift = 0.02;  // paint above the asphalt
 constexpr double kDecalLift = 0.015;   // manholes and drains above the asphalt
-constexpr double kGroundReach = 62.0;  // lateral extent of the ground strips (m)
+
+// What the style changes about the surfaces.
+struct SurfaceSpec {
+  bool sidewalks = true;
+  // A later pass along a street already driven adds no sidewalk of its own (street: it does, and
+  // the two coincide).
+  bool dedupe_sidewalks = false;
+  // World-mapped textures are turned by this angle, so their repeats do not line up with streets
+  // (which mostly run along the axes of a planned city); the repetitive world wants them to.
+  double uv_angle_rad = 0.41;
+  double dash_m = 3.0, dash_period_m = 9.0;                                     // centre line
+  enum class Details { kRandom, kNone, kPeriodic } details = Details::kRandom;  // manholes, drains
+  double ground_reach_m = 62.0, ground_piece_m = 6.0;  // lateral extent of the ground strips
+  double terrain_cell_m = 10.0, terrain_reach_m = 80.0, terrain_drop_m = 1.0;
+};
+
+SurfaceSpec surfaceSpec(WorldStyle style) {
+  SurfaceSpec spec;
+  if (style != WorldStyle::kStreet) spec.dedupe_sidewalks = true;
+  switch (style) {
+    case WorldStyle::kStreet:
+    case WorldStyle::kVegetation:
+      break;
+    case WorldStyle::kOpenRoad:  // a country road: grass to the asphalt, fields to the hills
+      spec.sidewalks = false;
+      spec.details = SurfaceSpec::Details::kNone;
+      spec.ground_reach_m = 150.0;
+      spec.ground_piece_m = 12.0;
+      spec.terrain_cell_m = 20.0;
+      spec.terrain_reach_m = 230.0;
+      spec.terrain_drop_m = 0.5;
+      break;
+    case WorldStyle::kSparseTexture:
+      spec.details = SurfaceSpec::Details::kNone;
+      break;
+    case WorldStyle::kRepetitive:  // every repeat and piece divides the period
+      spec.uv_angle_rad = 0.0;
+      spec.dash_m = 4.0;
+      spec.dash_period_m = kRepetitivePeriod_m;
+      spec.details = SurfaceSpec::Details::kPeriodic;
+      spec.terrain_cell_m = kRepetitivePeriod_m;
+      break;
+  }
+  return spec;
+}
 
 // A point across the street at a station, on the shared height field (not the station's own
 // height): wherever two passes' surfaces overlap they coincide.
@@ -25,21 +70,20 @@ Eigen::Vector3d at(const Street& street, const Station& st, double lateral, doub
   return {p.x(), p.y(), street.route.roadHeight(p) + dz};
 }
 
-// Texture coordinates from world x-y, turned by an odd angle so the texture's repeats do not line
-// up with streets (which mostly run along the axes of a planned city).
-Eigen::Vector2d worldUv(const Eigen::Vector2d& p, const Eigen::Vector2d& tile) {
-  const double c = std::cos(0.41), s = std::sin(0.41);
+// Texture coordinates from world x-y, turned by the spec's angle.
+Eigen::Vector2d worldUv(const Eigen::Vector2d& p, const Eigen::Vector2d& tile, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
   return Eigen::Vector2d(c * p.x() - s * p.y(), s * p.x() + c * p.y()).cwiseQuotient(tile);
 }
 
 // Horizontal strip between two stations over [l0, l1], texture in world coordinates.
 void worldStrip(Street& street, std::size_t tex, const Station& a, const Station& b, double l0,
-                double l1, double dz) {
+                double l1, double dz, double uv_angle) {
   const Eigen::Vector2d tile = street.lib.tile_m[tex];
   const std::array<Eigen::Vector3d, 4> p{at(street, a, l0, dz), at(street, a, l1, dz),
                                          at(street, b, l1, dz), at(street, b, l0, dz)};
   std::array<Eigen::Vector2d, 4> uv;
-  for (std::size_t i = 0; i < 4; ++i) uv[i] = worldUv(p[i].head<2>(), tile);
+  for (std::size_t i = 0; i < 4; ++i) uv[i] = worldUv(p[i].head<2>(), tile, uv_angle);
   street.mesh.quad(tex, p, uv);
 }
 
@@ -104,12 +148,13 @@ void sidewalkEnd(Street& street, const Station& st, double side) {
        Eigen::Vector2d(0, 0.6)});
 }
 
-void addSidewalks(Street& street, double side) {
+void addSidewalks(Street& street, const SurfaceSpec& spec, double side) {
   const double w = street.options.road_half_width_m, outer = w + street.options.sidewalk_width_m;
   bool open = false;  // inside a run of kept pieces
   for (std::size_t i = 0; i + 1 < street.stations.size(); ++i) {
     const Station &a = street.stations[i], &b = street.stations[i + 1];
-    const bool keep = !onOtherRoad(street, a, b, side * w, side * outer);
+    const bool keep = !onOtherRoad(street, a, b, side * w, side * outer) &&
+                      !(spec.dedupe_sidewalks && (revisited(street, a) || revisited(street, b)));
     if (keep != open) sidewalkEnd(street, a, side);
     if (keep) sidewalkPiece(street, a, b, side);
     open = keep;
@@ -149,13 +194,14 @@ void paintLine(Street& street, double s0, double s1, double lateral, double widt
   }
 }
 
-// Dashed centre line left of the driven lane (3 m dashes, 6 m gaps), solid edge lines.
-void addMarkings(Street& street, Rng& rng) {
+// Dashed centre line left of the driven lane (street: 3 m dashes, 6 m gaps), solid edge lines.
+void addMarkings(Street& street, const SurfaceSpec& spec, Rng& rng) {
   const double w = street.options.road_half_width_m;
   const double first = street.stations.front().s, last = street.stations.back().s;
   const double centre = std::min(1.6, 0.35 * w);
-  for (double s = first + rng.uniform(0.0, 9.0); s + 3.0 < last; s += 9.0)
-    paintLine(street, s, s + 3.0, centre, 0.12);
+  for (double s = first + rng.uniform(0.0, spec.dash_period_m); s + spec.dash_m < last;
+       s += spec.dash_period_m)
+    paintLine(street, s, s + spec.dash_m, centre, 0.12);
   for (double s = first; s < last; s += 6.0) {
     paintLine(street, s, std::min(s + 6.0, last), w - 0.3, 0.12);
     paintLine(street, s, std::min(s + 6.0, last), -(w - 0.3), 0.12);
@@ -164,10 +210,10 @@ void addMarkings(Street& street, Rng& rng) {
 
 // How far the ground may reach out from a station before it would cover another road (the route
 // passing by again, or this pass beyond a bend): the ground of each pass stops there.
-double groundReach(const Street& street, const Station& st, double side) {
+double groundReach(const Street& street, const SurfaceSpec& spec, const Station& st, double side) {
   const double w = street.options.road_half_width_m;
   double reach = w + street.options.sidewalk_width_m;
-  while (reach < kGroundReach &&
+  while (reach < spec.ground_reach_m &&
          !street.route.anyWithin(st.p + side * (reach + 2.0) * st.n, w + 1.0)) {
     reach += 2.0;
   }
@@ -176,73 +222,95 @@ double groundReach(const Street& street, const Station& st, double side) {
 
 // Manhole covers and gutter drains: flat, sparse, irregularly spaced road features of a few
 // decimetres, which stay visible (and trackable) where the mipmapped asphalt is a blur.
+void manhole(Street& street, const Eigen::Vector2d& c) {
+  const double z = street.route.roadHeight(c) + kDecalLift, r = 0.34;
+  for (int k = 0; k < 8; ++k) {
+    const double a0 = k * std::numbers::pi / 4.0, a1 = (k + 1) * std::numbers::pi / 4.0;
+    street.mesh.triangle(street.lib.manhole,
+                         {Eigen::Vector3d(c.x(), c.y(), z),
+                          Eigen::Vector3d(c.x() + r * std::cos(a0), c.y() + r * std::sin(a0), z),
+                          Eigen::Vector3d(c.x() + r * std::cos(a1), c.y() + r * std::sin(a1), z)},
+                         {Eigen::Vector2d(0.5, 0.5),
+                          Eigen::Vector2d(0.5 + 0.5 * std::cos(a0), 0.5 + 0.5 * std::sin(a0)),
+                          Eigen::Vector2d(0.5 + 0.5 * std::cos(a1), 0.5 + 0.5 * std::sin(a1))});
+  }
+}
+
+void drain(Street& street, double s, double side) {
+  const double w = street.options.road_half_width_m;
+  const Station a = stationAt(street.stations, s);
+  const Station b = stationAt(street.stations, s + 0.5);
+  const double l0 = side * (w - 0.05), l1 = side * (w - 0.4);
+  street.mesh.quad(
+      street.lib.grate,
+      {at(street, a, l0, kDecalLift), at(street, a, l1, kDecalLift), at(street, b, l1, kDecalLift),
+       at(street, b, l0, kDecalLift)},
+      {Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 1), Eigen::Vector2d(0, 1)});
+}
+
 void addRoadDetails(Street& street, Rng& rng) {
   const double w = street.options.road_half_width_m;
   const double first = street.stations.front().s, last = street.stations.back().s;
   for (double s = first + rng.uniform(0.0, 40.0); s < last; s += rng.uniform(25.0, 60.0)) {
     const Station st = stationAt(street.stations, s);
-    const Eigen::Vector2d c = st.p + rng.uniform(-0.4, 0.4) * w * st.n;
-    const double z = street.route.roadHeight(c) + kDecalLift, r = 0.34;
-    for (int k = 0; k < 8; ++k) {
-      const double a0 = k * std::numbers::pi / 4.0, a1 = (k + 1) * std::numbers::pi / 4.0;
-      street.mesh.triangle(street.lib.manhole,
-                           {Eigen::Vector3d(c.x(), c.y(), z),
-                            Eigen::Vector3d(c.x() + r * std::cos(a0), c.y() + r * std::sin(a0), z),
-                            Eigen::Vector3d(c.x() + r * std::cos(a1), c.y() + r * std::sin(a1), z)},
-                           {Eigen::Vector2d(0.5, 0.5),
-                            Eigen::Vector2d(0.5 + 0.5 * std::cos(a0), 0.5 + 0.5 * std::sin(a0)),
-                            Eigen::Vector2d(0.5 + 0.5 * std::cos(a1), 0.5 + 0.5 * std::sin(a1))});
-    }
+    manhole(street, st.p + rng.uniform(-0.4, 0.4) * w * st.n);
   }
-  for (double s = first + rng.uniform(0.0, 20.0); s < last; s += rng.uniform(15.0, 40.0)) {
-    const double side = rng.chance(0.5) ? 1.0 : -1.0;
-    const Station a = stationAt(street.stations, s);
-    const Station b = stationAt(street.stations, s + 0.5);
-    const double l0 = side * (w - 0.05), l1 = side * (w - 0.4);
-    street.mesh.quad(street.lib.grate,
-                     {at(street, a, l0, kDecalLift), at(street, a, l1, kDecalLift),
-                      at(street, b, l1, kDecalLift), at(street, b, l0, kDecalLift)},
-                     {Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0), Eigen::Vector2d(1, 1),
-                      Eigen::Vector2d(0, 1)});
+  for (double s = first + rng.uniform(0.0, 20.0); s < last; s += rng.uniform(15.0, 40.0))
+    drain(street, s, rng.chance(0.5) ? 1.0 : -1.0);
+}
+
+// One manhole and a drain on each side per period, at the same places in every period (arc length
+// from the route's start), built by the first pass along a street only.
+void addPeriodicRoadDetails(Street& street) {
+  const double w = street.options.road_half_width_m, period = kRepetitivePeriod_m;
+  const double first = street.stations.front().s, last = street.stations.back().s;
+  for (double s = std::ceil(first / period) * period; s + period < last; s += period) {
+    const Station st = stationAt(street.stations, s + 7.0);
+    if (revisited(street, st)) continue;
+    manhole(street, st.p - 0.2 * w * st.n);
+    if (!revisited(street, stationAt(street.stations, s + 2.0))) {
+      drain(street, s + 2.0, 1.0);
+      drain(street, s + 2.0, -1.0);
+    }
   }
 }
 
 // Road in three lanes and ground in pieces of <= 6 m across: every vertex sits on the shared
 // height field, so surfaces of different passes follow it closely where they overlap.
-void addRoadAndGround(Street& street) {
+void addRoadAndGround(Street& street, const SurfaceSpec& spec) {
   const double w = street.options.road_half_width_m;
   std::vector<std::array<double, 2>> reach;  // per station: left, right
   for (const auto& st : street.stations)
-    reach.push_back({groundReach(street, st, 1.0), groundReach(street, st, -1.0)});
+    reach.push_back({groundReach(street, spec, st, 1.0), groundReach(street, spec, st, -1.0)});
   for (std::size_t i = 0; i + 1 < street.stations.size(); ++i) {
     const Station &a = street.stations[i], &b = street.stations[i + 1];
     for (int lane = 0; lane < 3; ++lane)
       worldStrip(street, street.lib.asphalt, a, b, -w + lane * 2.0 * w / 3.0,
-                 -w + (lane + 1) * 2.0 * w / 3.0, 0.0);
+                 -w + (lane + 1) * 2.0 * w / 3.0, 0.0, spec.uv_angle_rad);
     for (std::size_t k = 0; k < 2; ++k) {
       const double side = k == 0 ? 1.0 : -1.0, outer = std::min(reach[i][k], reach[i + 1][k]);
-      const int pieces = static_cast<int>(std::ceil((outer - w) / 6.0));
+      const int pieces = static_cast<int>(std::ceil((outer - w) / spec.ground_piece_m));
       for (int j = 0; j < pieces; ++j) {
         const double l0 = w - 0.2 + (outer - w + 0.2) * j / pieces;
         const double l1 = w - 0.2 + (outer - w + 0.2) * (j + 1) / pieces;
-        worldStrip(street, street.lib.ground, a, b, side * l0, side * l1, -kGroundDrop);
+        worldStrip(street, street.lib.ground, a, b, side * l0, side * l1, -kGroundDrop,
+                   spec.uv_angle_rad);
       }
     }
   }
 }
 
-// Coarse terrain 1 m under the street surfaces, out to 80 m from the route: wherever the strips
-// leave a gap (crossings, beyond the buildings), the view still ends on ground.
-void addTerrain(Street& street) {
-  constexpr double kCell = 10.0, kReach = 80.0;
+// Coarse terrain under the street surfaces (street: 1 m under, out to 80 m from the route):
+// wherever the strips leave a gap (crossings, beyond the buildings), the view still ends on ground.
+void addTerrain(Street& street, const SurfaceSpec& spec) {
+  const double cell = spec.terrain_cell_m, reach = spec.terrain_reach_m;
   std::set<std::pair<long, long>> cells;  // ordered: the mesh does not depend on hashing
-  const long span = static_cast<long>(kReach / kCell) + 1;
+  const long span = static_cast<long>(reach / cell) + 1;
   for (const auto& st : street.stations) {
-    const long cx = std::lround(st.p.x() / kCell), cy = std::lround(st.p.y() / kCell);
+    const long cx = std::lround(st.p.x() / cell), cy = std::lround(st.p.y() / cell);
     for (long dx = -span; dx <= span; ++dx) {
       for (long dy = -span; dy <= span; ++dy) {
-        if ((dx * dx + dy * dy) * kCell * kCell <= kReach * kReach)
-          cells.insert({cx + dx, cy + dy});
+        if ((dx * dx + dy * dy) * cell * cell <= reach * reach) cells.insert({cx + dx, cy + dy});
       }
     }
   }
@@ -253,10 +321,10 @@ void addTerrain(Street& street) {
     std::array<Eigen::Vector2d, 4> uv;
     const std::array<std::pair<int, int>, 4> corner{{{0, 0}, {1, 0}, {1, 1}, {0, 1}}};
     for (std::size_t i = 0; i < 4; ++i) {
-      const Eigen::Vector2d q(static_cast<double>(cx + corner[i].first) * kCell,
-                              static_cast<double>(cy + corner[i].second) * kCell);
-      p[i] = Eigen::Vector3d(q.x(), q.y(), street.route.roadHeight(q) - 1.0);
-      uv[i] = worldUv(q, tile);
+      const Eigen::Vector2d q(static_cast<double>(cx + corner[i].first) * cell,
+                              static_cast<double>(cy + corner[i].second) * cell);
+      p[i] = Eigen::Vector3d(q.x(), q.y(), street.route.roadHeight(q) - spec.terrain_drop_m);
+      uv[i] = worldUv(q, tile, spec.uv_angle_rad);
     }
     street.mesh.quad(tex, p, uv);
   }
@@ -265,13 +333,17 @@ void addTerrain(Street& street) {
 }  // namespace
 
 void addStreetSurfaces(Street& street, std::uint64_t seed) {
+  const SurfaceSpec spec = surfaceSpec(street.options.style);
   Rng rng = Rng::derive(seed, 100);
-  addRoadAndGround(street);
-  addTerrain(street);
-  addSidewalks(street, 1.0);
-  addSidewalks(street, -1.0);
-  addMarkings(street, rng);
-  addRoadDetails(street, rng);
+  addRoadAndGround(street, spec);
+  addTerrain(street, spec);
+  if (spec.sidewalks) {
+    addSidewalks(street, spec, 1.0);
+    addSidewalks(street, spec, -1.0);
+  }
+  addMarkings(street, spec, rng);
+  if (spec.details == SurfaceSpec::Details::kRandom) addRoadDetails(street, rng);
+  if (spec.details == SurfaceSpec::Details::kPeriodic) addPeriodicRoadDetails(street);
 }
 
 }  // namespace gvio::sim::detail

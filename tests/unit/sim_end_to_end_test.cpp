@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <yaml-cpp/yaml.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
@@ -80,11 +81,12 @@ TEST_F(SimEndToEnd, SameSeedIsByteIdentical) {
                           traj, (dir_->path() / "b").string()))
           .exit_code,
       0);
-  ASSERT_EQ(
-      runGvio(fmt::format("simulate --trajectory {} --seconds 1 --seed 7 --out {} --no-progress",
-                          traj, (dir_->path() / "c").string()))
-          .exit_code,
-      0);
+  // The default world style named explicitly is the same drive.
+  ASSERT_EQ(runGvio(fmt::format("simulate --trajectory {} --seconds 1 --seed 7 --world-style "
+                                "street --out {} --no-progress",
+                                traj, (dir_->path() / "c").string()))
+                .exit_code,
+            0);
   ASSERT_EQ(
       runGvio(fmt::format("simulate --trajectory {} --seconds 1 --seed 8 --out {} --no-progress",
                           traj, (dir_->path() / "d").string()))
@@ -243,6 +245,58 @@ TEST_F(SimEndToEnd, MotionBlurAndExposureChange) {
   EXPECT_GT(cv::mean(bright)[0], 1.08 * cv::mean(plain)[0]);
 }
 
+// --world-style (or sim.world_style) picks the world: recorded in sim.yaml, another world.ply.
+TEST_F(SimEndToEnd, WorldStyleReachesTheWorld) {
+  const std::string traj = (dir_->path() / "drive.tum").string();
+  for (const char* style : {"street", "open_road"}) {
+    const auto r = runGvio(fmt::format(
+        "simulate --trajectory {} --seconds 0.3 --seed 7 --world-style {} --out {} --no-progress",
+        traj, style, (dir_->path() / style).string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_THAT(r.out, HasSubstr(fmt::format("{} world", style)));
+    const YAML::Node yaml = YAML::LoadFile((dir_->path() / style / "sim.yaml").string());
+    EXPECT_EQ(yaml["config"]["sim"]["world_style"].as<std::string>(), style);
+  }
+  EXPECT_NE(readText(dir_->path() / "street" / "world" / "world.ply"),
+            readText(dir_->path() / "open_road" / "world" / "world.ply"));
+}
+
+// sim.imu_noise_scale_min/max: the drive's IMU noise is drawn per seed and stated where the
+// layout can (sim.yaml always, EuRoC's imu0/sensor.yaml too); by default it is imu.* exactly.
+TEST_F(SimEndToEnd, ImuNoiseRangeIsDrawnAndRecorded) {
+  const ImuNoise nominal;
+  const YAML::Node plain = YAML::LoadFile((out() / "sim.yaml").string())["imu_noise"];
+  EXPECT_EQ(plain["acc_noise_density"].as<double>(), nominal.acc_noise_density);
+  EXPECT_EQ(plain["gyr_random_walk"].as<double>(), nominal.gyr_random_walk);
+  for (const auto& scale : plain["scale"]) EXPECT_EQ(scale.as<double>(), 1.0);
+
+  const fs::path out_dir = dir_->path() / "imu_range";
+  const auto r = runGvio(fmt::format(
+      "simulate --trajectory {} --seconds 0.3 --seed 11 --format euroc --set "
+      "sim.imu_noise_scale_min=0.5 --set sim.imu_noise_scale_max=4 --out {} --no-progress",
+      (dir_->path() / "drive.tum").string(), out_dir.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const YAML::Node drawn = YAML::LoadFile((out_dir / "sim.yaml").string())["imu_noise"];
+  const io::Dataset ds = io::readDataset(out_dir, std::nullopt, {});
+  ASSERT_TRUE(ds.imu_noise);
+  const std::array<std::pair<const char*, std::pair<double, double>>, 4> quantities{{
+      {"acc_noise_density", {ds.imu_noise->acc_noise_density, nominal.acc_noise_density}},
+      {"gyr_noise_density", {ds.imu_noise->gyr_noise_density, nominal.gyr_noise_density}},
+      {"acc_random_walk", {ds.imu_noise->acc_random_walk, nominal.acc_random_walk}},
+      {"gyr_random_walk", {ds.imu_noise->gyr_random_walk, nominal.gyr_random_walk}},
+  }};
+  for (std::size_t i = 0; i < 4; ++i) {
+    const auto& [key, values] = quantities[i];
+    const double value = drawn[key].as<double>(), scale = drawn["scale"][i].as<double>();
+    std::cout << "[ sim ] " << key << " " << value << " (x " << scale << ")\n";
+    EXPECT_DOUBLE_EQ(values.first, value) << key;  // the dataset states what the drive has
+    EXPECT_DOUBLE_EQ(value, scale * values.second) << key;
+    EXPECT_GE(scale, 0.5) << key;
+    EXPECT_LE(scale, 4.0) << key;
+    EXPECT_NE(scale, 1.0) << key;
+  }
+}
+
 TEST_F(SimEndToEnd, BadInputIsOneLineExit2) {
   const fs::path d = dir_->path();
   writeText(d / "three.tum", "0 0 0 0 0 0 0 1\n0.1 1 0 0 0 0 0 1\n0.2 2 0 0 0 0 0 1\n");
@@ -260,6 +314,14 @@ TEST_F(SimEndToEnd, BadInputIsOneLineExit2) {
        "outside the drive"},
       {"simulate --trajectory " + traj + " --gnss-outage 5 --out " + (d / "x5").string(), "T0:T1"},
       {"simulate --trajectory " + traj + " --seconds 1 --out " + out().string(), "not empty"},
+      {"simulate --trajectory " + traj + " --world-style foo --out " + (d / "x6").string(),
+       "--world-style 'foo'"},
+      {"simulate --trajectory " + traj + " --set sim.world_style=Street --out " +
+           (d / "x7").string(),
+       "sim.world_style"},
+      {"simulate --trajectory " + traj + " --set sim.imu_noise_scale_max=0.5 --out " +
+           (d / "x8").string(),
+       "sim.imu_noise_scale_max"},
   };
   for (const auto& [args, needle] : cases) {
     const auto r = runGvio(args + " --no-progress");

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -209,6 +210,44 @@ TEST(SimImu, RejectsBadOptions) {
   options.rate_hz = 100.0;
   options.noise.acc_noise_density = -1.0;
   EXPECT_THROW((void)synthesizeImu(still, options, 1), InvalidInput);
+}
+
+// Per-drive noise (sim.imu_noise_scale_min/max): each density times its own log-uniform draw.
+TEST(SimImu, DrawnNoiseIsReproducibleBySeedAndWithinTheRange) {
+  const ImuNoise nominal;
+  const ImuNoiseDraw a = drawImuNoise(nominal, 0.5, 4.0, 7), b = drawImuNoise(nominal, 0.5, 4.0, 7);
+  EXPECT_EQ(a.scale, b.scale);
+  EXPECT_NE(a.scale, drawImuNoise(nominal, 0.5, 4.0, 8).scale);
+  EXPECT_EQ(a.noise.acc_noise_density, nominal.acc_noise_density * a.scale[0]);
+  EXPECT_EQ(a.noise.gyr_noise_density, nominal.gyr_noise_density * a.scale[1]);
+  EXPECT_EQ(a.noise.acc_random_walk, nominal.acc_random_walk * a.scale[2]);
+  EXPECT_EQ(a.noise.gyr_random_walk, nominal.gyr_random_walk * a.scale[3]);
+  // Log-uniform over many seeds: within the range, log of the scale uniform (mean and spread).
+  double sum = 0.0, sum2 = 0.0;
+  int n = 0;
+  for (std::uint64_t seed = 0; seed < 2000; ++seed) {
+    for (const double scale : drawImuNoise(nominal, 0.5, 4.0, seed).scale) {
+      ASSERT_GE(scale, 0.5);
+      ASSERT_LE(scale, 4.0);
+      const double x = std::log(scale);
+      sum += x;
+      sum2 += x * x;
+      ++n;
+    }
+  }
+  const double mean = sum / n, var = sum2 / n - mean * mean;
+  const double lo = std::log(0.5), hi = std::log(4.0);
+  EXPECT_NEAR(mean, (lo + hi) / 2.0, 0.02);
+  EXPECT_NEAR(var, (hi - lo) * (hi - lo) / 12.0, 0.02);
+}
+
+TEST(SimImu, UnitScaleKeepsTheNominalNoiseExactly) {
+  const ImuNoise nominal;
+  const ImuNoiseDraw d = drawImuNoise(nominal, 1.0, 1.0, 42);
+  EXPECT_EQ(d.scale, (std::array<double, 4>{1.0, 1.0, 1.0, 1.0}));
+  EXPECT_EQ(0, std::memcmp(&d.noise, &nominal, sizeof(ImuNoise)));
+  EXPECT_THROW((void)drawImuNoise(nominal, 2.0, 1.0, 1), InvalidInput);
+  EXPECT_THROW((void)drawImuNoise(nominal, 0.0, 1.0, 1), InvalidInput);
 }
 
 }  // namespace

@@ -21,127 +21,13 @@
 #include "sim/kitti_convention.hpp"
 #include "sim/textures.hpp"
 #include "sim/world.hpp"
+#include "sim_world_fixture.hpp"
 #include "support/render_fixture.hpp"
 
 namespace gvio::sim {
 namespace {
 
-constexpr double kBodyHeight = 0.93;    // route points are body positions above the road
-constexpr double kCameraHeight = 1.65;  // KITTI's camera above the road
-
-// A drive of legs {length m, turn rad spread over the leg}, a point every 0.5 m, on flat ground.
-std::vector<Eigen::Vector3d> drive(const std::vector<std::pair<double, double>>& legs) {
-  std::vector<Eigen::Vector3d> route{Eigen::Vector3d(0, 0, kBodyHeight)};
-  double heading = 0.0;
-  for (const auto& [length, turn] : legs) {
-    const int steps = static_cast<int>(std::lround(length / 0.5));
-    for (int k = 0; k < steps; ++k) {
-      heading += turn / steps;
-      route.push_back(route.back() +
-                      0.5 * Eigen::Vector3d(std::cos(heading), std::sin(heading), 0));
-    }
-  }
-  return route;
-}
-
-// 400 m: 150 m east, a left turn, 80 m north, a right turn, on east. Turn radius 25 m: 1 m along
-// it turns the camera 2.3 deg, about what KITTI's 10 Hz frames turn at street corners.
-std::vector<Eigen::Vector3d> twoTurns() {
-  const double q = std::numbers::pi / 2, arc = 25.0 * q;
-  return drive({{150.0, 0.0}, {arc, q}, {80.0, 0.0}, {arc, -q}, {400.0 - 230.0 - 2 * arc, 0.0}});
-}
-
-// Lemniscate of Gerono: crosses itself at right angles in the middle.
-std::vector<Eigen::Vector3d> figureEight() {
-  std::vector<Eigen::Vector3d> route;
-  const double a = 150.0;
-  for (int i = 0; i <= 1200; ++i) {
-    const double t = 2.0 * std::numbers::pi * i / 1200.0;
-    route.emplace_back(a * std::sin(t), a * std::sin(t) * std::cos(t), kBodyHeight);
-  }
-  return route;
-}
-
-// Vertices closer than `radius` (2-D) to a route point and higher than 0.2 m above the road there:
-// the highest road height (route height - body height) within radius + 1 m, since where passes
-// cross at different recorded heights the world's road lies between them. A grid of route points
-// keeps the search local.
-std::size_t verticesOnRoad(const World& world, const std::vector<Eigen::Vector3d>& route,
-                           double radius, double body_height,
-                           const std::vector<std::size_t>& skip_textures = {}) {
-  constexpr double kCell = 10.0;
-  std::map<std::pair<long, long>, std::vector<Eigen::Vector3d>> grid;
-  auto cell = [](double v) { return static_cast<long>(std::floor(v / kCell)); };
-  for (const auto& p : route) grid[{cell(p.x()), cell(p.y())}].push_back(p);
-  std::size_t bad = 0;
-  for (const auto& mesh : world.scene.meshes) {
-    if (std::find(skip_textures.begin(), skip_textures.end(), mesh.texture) != skip_textures.end())
-      continue;
-    for (const auto& v : mesh.vertices) {
-      double nearest = radius + kCell, road_z = -1e9;
-      for (long cx = cell(v.x()) - 1; cx <= cell(v.x()) + 1; ++cx) {
-        for (long cy = cell(v.y()) - 1; cy <= cell(v.y()) + 1; ++cy) {
-          const auto it = grid.find({cx, cy});
-          if (it == grid.end()) continue;
-          for (const auto& p : it->second) {
-            const double d = (p - v).head<2>().norm();
-            nearest = std::min(nearest, d);
-            if (d < radius + 1.0) road_z = std::max(road_z, p.z() - body_height);
-          }
-        }
-      }
-      if (nearest < radius && v.z() > road_z + 0.2) {
-        if (bad < 10 && std::getenv("GVIO_SIM_DEBUG") != nullptr)
-          std::cout << "    on road: texture " << mesh.texture << " at " << v.transpose() << "\n";
-        ++bad;
-      }
-    }
-  }
-  return bad;
-}
-
-using Rect = std::array<Eigen::Vector2d, 4>;
-
-// Building footprints, read back from the mesh: a building's two long walls carry its facade
-// texture and are stored one after the other; their bottom edges are two sides of the footprint.
-std::vector<Rect> buildingFootprints(const World& world, const std::vector<std::size_t>& facades) {
-  std::vector<Rect> out;
-  for (const auto& m : world.scene.meshes) {
-    if (std::find(facades.begin(), facades.end(), m.texture) == facades.end()) continue;
-    for (std::size_t i = 0; i + 7 < m.vertices.size(); i += 8) {
-      out.push_back({m.vertices[i].head<2>(), m.vertices[i + 1].head<2>(),
-                     m.vertices[i + 4].head<2>(), m.vertices[i + 5].head<2>()});
-    }
-  }
-  return out;
-}
-
-// How deep two convex quadrilaterals overlap (separating axes; 0 when apart).
-double overlapDepth(const Rect& a, const Rect& b) {
-  double depth = 1e9;
-  for (const Rect* r : {&a, &b}) {
-    for (std::size_t i = 0; i < 4; ++i) {
-      const Eigen::Vector2d e = ((*r)[(i + 1) % 4] - (*r)[i]).normalized();
-      const Eigen::Vector2d axis(-e.y(), e.x());
-      double a0 = 1e9, a1 = -1e9, b0 = 1e9, b1 = -1e9;
-      for (const auto& p : a) a0 = std::min(a0, p.dot(axis)), a1 = std::max(a1, p.dot(axis));
-      for (const auto& p : b) b0 = std::min(b0, p.dot(axis)), b1 = std::max(b1, p.dot(axis));
-      depth = std::min(depth, std::min(a1, b1) - std::max(a0, b0));
-    }
-  }
-  return std::max(depth, 0.0);
-}
-
-double deepestBuildingOverlap(const std::vector<Rect>& rects) {
-  double worst = 0.0;
-  for (std::size_t i = 0; i < rects.size(); ++i) {
-    for (std::size_t j = i + 1; j < rects.size(); ++j) {
-      if ((rects[i][0] - rects[j][0]).norm() < 120.0)  // footprints are < 45 m across
-        worst = std::max(worst, overlapDepth(rects[i], rects[j]));
-    }
-  }
-  return worst;
-}
+using namespace world_fixture;  // NOLINT(google-build-using-namespace): test helpers
 
 TEST(SimWorldTest, SameSeedSameWorldOtherSeedOtherWorld) {
   const auto route = twoTurns();
@@ -184,15 +70,9 @@ TEST(SimWorldTest, NothingStandsOnTheRoadWhereTheRouteCrossesItself) {
 // A block driven twice gets one row of buildings, not two: no building overlaps another (row
 // neighbours may touch), and the second pass only fills gaps the first one left.
 TEST(SimWorldTest, RevisitedStreetsAreNotBuiltTwice) {
-  const double q = std::numbers::pi / 2;
-  const std::vector<std::pair<double, double>> block{{200.0, 0.0}, {20.0, q},    {150.0, 0.0},
-                                                     {20.0, q},    {200.0, 0.0}, {20.0, q},
-                                                     {150.0, 0.0}, {20.0, q}};
-  std::vector<std::pair<double, double>> twice = block;
-  twice.insert(twice.end(), block.begin(), block.end());
   WorldOptions o;
   o.texture_size_px = 64;
-  const World once = buildWorld(drive(block), o), both = buildWorld(drive(twice), o);
+  const World once = buildWorld(block(1), o), both = buildWorld(block(2), o);
   const TextureLibrary lib = makeTextureLibrary(o.seed, 64);
   const auto a = buildingFootprints(once, lib.facade_front);
   const auto b = buildingFootprints(both, lib.facade_front);
@@ -201,7 +81,7 @@ TEST(SimWorldTest, RevisitedStreetsAreNotBuiltTwice) {
   EXPECT_GT(a.size(), 40U);
   EXPECT_LT(static_cast<double>(b.size()), 1.5 * static_cast<double>(a.size()));
   EXPECT_LT(deepestBuildingOverlap(b), 0.15);
-  EXPECT_EQ(verticesOnRoad(both, drive(twice), o.road_half_width_m, o.body_height_m), 0U);
+  EXPECT_EQ(verticesOnRoad(both, block(2), o.road_half_width_m, o.body_height_m), 0U);
 }
 
 TEST(SimWorldTest, RejectsBadInput) {
@@ -230,37 +110,6 @@ TEST(SimWorldTest, TexturesHaveContrastAndAreDeterministic) {
 
 render::PinholeIntrinsics kittiCamera() {
   return sim::kittiIntrinsics();
-}
-
-// Camera 1.65 m above the road at arc length s, looking along the route (z forward, y down).
-Eigen::Isometry3d cameraAt(const std::vector<Eigen::Vector3d>& route, double s) {
-  auto at = [&](double arc) {
-    double acc = 0.0;
-    for (std::size_t i = 0; i + 1 < route.size(); ++i) {
-      const double len = (route[i + 1] - route[i]).head<2>().norm();
-      if (acc + len >= arc)
-        return Eigen::Vector3d(route[i] + (arc - acc) / len * (route[i + 1] - route[i]));
-      acc += len;
-    }
-    return route.back();
-  };
-  const Eigen::Vector3d p = at(s);
-  const Eigen::Vector3d t = Eigen::Vector3d(at(s + 1.0) - at(s - 1.0)).normalized();
-  Eigen::Matrix3d R;
-  R.col(2) = t;                                    // forward
-  R.col(0) = Eigen::Vector3d(t.y(), -t.x(), 0.0);  // right
-  R.col(1) = Eigen::Vector3d(0, 0, -1);            // down
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = R;
-  T.translation() = Eigen::Vector3d(p.x(), p.y(), p.z() - kBodyHeight + kCameraHeight);
-  return T;
-}
-
-cv::Mat greyOf(const render::ImageRgba& img) {  // grey textures: R = G = B
-  cv::Mat grey;
-  cv::extractChannel(
-      cv::Mat(img.height, img.width, CV_8UC4, const_cast<std::uint8_t*>(img.rgba.data())), grey, 0);
-  return grey;
 }
 
 // One EGL context and renderer for the suite (support/render_fixture.hpp).
@@ -373,27 +222,6 @@ TEST_F(SimWorldRenderTest, CornersAndKltAlongTheStreet) {
   }
   std::cout << "[ sim world ] " << world.triangles << " triangles; " << summary.text() << "\n";
   saveTopDown(world, route, "/tmp/sim_world_topdown.png");
-}
-
-// KITTI odometry ground truth (cam0 poses; world x right, y down, z forward at the first frame)
-// as camera poses in an ENU-like frame: east = x, north = z, up = -y.
-std::vector<Eigen::Isometry3d> kittiCameraPoses(const std::filesystem::path& file) {
-  Eigen::Matrix3d M;
-  M << 1, 0, 0, 0, 0, 1, 0, -1, 0;
-  std::vector<Eigen::Isometry3d> poses;
-  std::ifstream in(file);
-  for (std::string line; std::getline(in, line);) {
-    std::istringstream ls(line);
-    Eigen::Matrix<double, 3, 4> m;
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 4; ++c) ls >> m(r, c);
-    }
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = M * m.leftCols<3>();
-    T.translation() = M * m.col(3);
-    poses.push_back(T);
-  }
-  return poses;
 }
 
 // The real drive (KITTI 00, 3.7 km, crossing and revisiting its streets): triangle budget, build
