@@ -1,7 +1,7 @@
 #pragma once
 // The city block the loop-closure tests drive: a rounded 80 x 50 m rectangle (corner radius 12 m)
 // counter-clockwise from the origin heading east, at 8 m/s for 55 s (1.3 laps), body poses at
-// 10 Hz with z up, 0.93 m above the road (cli_loops_test.cpp has its own copy of this drive).
+// 10 Hz with z up, 0.93 m above the road.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>

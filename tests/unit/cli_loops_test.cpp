@@ -10,11 +10,11 @@
 #include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>
-#include <numbers>
 
 #include "fusion/vio_enu_alignment.hpp"
 #include "io/loops_csv.hpp"
 #include "io/trajectory_io.hpp"
+#include "support/block_drive.hpp"
 #include "support/fixtures.hpp"
 
 namespace gvio::test {
@@ -23,50 +23,6 @@ namespace fs = std::filesystem;
 
 constexpr const char* kSimGeo =
     "--set fusion.origin=48.98253,8.39035,116.4 --set fusion.lever_arm_b=[0,0,0.8]";
-
-// Arc length s on a rounded rectangle (straights 80 and 50 m, corner radius 12 m), counter-
-// clockwise from the origin heading east: position and heading.
-Eigen::Vector3d blockPose(double s) {
-  constexpr double kLong = 80.0, kShort = 50.0, kCorner = 12.0;
-  const double arc = std::numbers::pi / 2.0 * kCorner;
-  const double perimeter = 2.0 * (kLong + kShort) + 4.0 * arc;
-  s = std::fmod(s, perimeter);
-  Eigen::Vector2d p = Eigen::Vector2d::Zero();
-  double heading = 0.0;
-  for (const double straight : {kLong, kShort, kLong, kShort}) {
-    const Eigen::Vector2d t(std::cos(heading), std::sin(heading));
-    if (s <= straight) return {p.x() + s * t.x(), p.y() + s * t.y(), heading};
-    p += straight * t;
-    s -= straight;
-    const Eigen::Vector2d centre = p + kCorner * Eigen::Vector2d(-t.y(), t.x());
-    const double a = std::min(s, arc) / kCorner;
-    const auto on_corner = [&](double angle) {
-      return Eigen::Vector2d(centre.x() + kCorner * std::sin(heading + angle),
-                             centre.y() - kCorner * std::cos(heading + angle));
-    };
-    if (s <= arc) {
-      const Eigen::Vector2d q = on_corner(a);
-      return {q.x(), q.y(), heading + a};
-    }
-    p = on_corner(std::numbers::pi / 2.0);
-    heading += std::numbers::pi / 2.0;
-    s -= arc;
-  }
-  return {p.x(), p.y(), heading};
-}
-
-Trajectory blockDrive() {
-  Trajectory t;
-  for (int i = 0; i <= 550; ++i) {  // 55 s at 10 Hz
-    const Eigen::Vector3d p = blockPose(8.0 * 0.1 * i);
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = Eigen::AngleAxisd(p.z(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    T.translation() = Eigen::Vector3d(p.x(), p.y(), 0.93);
-    t.poses.push_back(T);
-    t.t_ns.push_back(static_cast<std::int64_t>(i) * 100'000'000LL);
-  }
-  return t;
-}
 
 class CliLoops : public ::testing::Test {
  protected:
