@@ -10,6 +10,7 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include "fusion/batch_solver.hpp"
 #include "fusion/gnss_factors.hpp"
 #include "odometry/error.hpp"
 #include "odometry/pose_manifold.hpp"
@@ -88,15 +89,7 @@ class Graph {
                                poses_[loops_[k].j].data());
     }
     if (fixes_.empty()) problem.SetParameterBlockConstant(poses_.front().data());
-    ceres::Solver::Options options;
-    options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    if (!ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) &&
-        !ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE)) {
-      options.linear_solver_type = ceres::DENSE_QR;
-    }
-    options.max_num_iterations = config_.max_iterations;
-    options.num_threads = 1;
-    options.logging_type = ceres::SILENT;
+    const ceres::Solver::Options options = batchSolverOptions(config_.max_iterations);
     ceres::Solver::Summary summary;
     ceres::Solve(options, &problem, &summary);
     return summary;

@@ -11,19 +11,13 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include "fusion/batch_solver.hpp"
 #include "fusion/gnss_factors.hpp"
 #include "odometry/error.hpp"
 #include "odometry/pose_manifold.hpp"
 
 namespace gvio::fusion {
 namespace {
-
-ceres::LinearSolverType sparseOrDense() {
-  const bool sparse = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ||
-                      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE);
-  // The graph is a chain (block tridiagonal): sparse Cholesky keeps hours of fixes cheap.
-  return sparse ? ceres::SPARSE_NORMAL_CHOLESKY : ceres::DENSE_QR;
-}
 
 // Marginal covariances of the node poses, rotated from the manifold's body-frame tangent
 // (dphi, dp_body) to ENU axes: dtheta = R dphi, dp = R dp_body.
@@ -107,11 +101,7 @@ SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Ve
     problem.AddResidualBlock(new ceres::NormalPrior(A, Eigen::Vector3d::Zero()), nullptr,
                              biases[0].data());
   }
-  ceres::Solver::Options options;
-  options.linear_solver_type = sparseOrDense();
-  options.max_num_iterations = config.max_iterations;
-  options.num_threads = 1;
-  options.logging_type = ceres::SILENT;
+  const ceres::Solver::Options options = batchSolverOptions(config.max_iterations);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   SmoothedNodes out;

@@ -8,9 +8,20 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "odometry/lie.hpp"
 #include "odometry/pose_manifold.hpp"
 
 namespace gvio::test {
+
+// A pose block (odometry/pose_manifold.hpp) of the rotation Exp(phi) and position p.
+inline std::vector<double> poseBlock(const Eigen::Vector3d& phi, const Eigen::Vector3d& p) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = odometry::expSo3(phi);
+  T.translation() = p;
+  std::vector<double> x(odometry::kPoseAmbient);
+  odometry::poseToBlock(T, x.data());
+  return x;
+}
 
 // d r(Plus(x, delta)) / d delta, for block `b` of a cost function.
 template <int R>

@@ -17,4 +17,15 @@ inline CameraModel kittiRectifiedCamera() {
 }
 inline constexpr double kKittiBaselineM = 0.54;
 
+// The same camera looking forward from a body with x forward, y left, z up (camera x right, y
+// down, z forward), 1 m ahead of and 0.7 m above the body origin.
+inline CameraModel kittiForwardCamera() {
+  CameraModel c = kittiRectifiedCamera();
+  Eigen::Matrix3d R;
+  R << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  c.T_b_c.linear() = R;
+  c.T_b_c.translation() = Eigen::Vector3d(1.0, 0.0, 0.7);
+  return c;
+}
+
 }  // namespace gvio::test

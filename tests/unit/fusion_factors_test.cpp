@@ -15,15 +15,7 @@ namespace {
 
 using test::analyticTangentJacobian;
 using test::numericTangentJacobian;
-
-std::vector<double> poseBlock(const Eigen::Vector3d& phi, const Eigen::Vector3d& p) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = odometry::expSo3(phi);
-  T.translation() = p;
-  std::vector<double> x(7);
-  odometry::poseToBlock(T, x.data());
-  return x;
-}
+using test::poseBlock;
 
 TEST(RelativePoseFactor, ZeroAtTheMeasurementAndJacobians) {
   std::vector<std::vector<double>> blocks = {

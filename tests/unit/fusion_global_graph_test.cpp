@@ -20,16 +20,8 @@ namespace {
 
 using test::analyticTangentJacobian;
 using test::numericTangentJacobian;
+using test::poseBlock;
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
-
-std::vector<double> poseBlock(const Eigen::Vector3d& phi, const Eigen::Vector3d& p) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = odometry::expSo3(phi);
-  T.translation() = p;
-  std::vector<double> x(7);
-  odometry::poseToBlock(T, x.data());
-  return x;
-}
 
 TEST(RelativePoseFactor, FullSquareRootInformationWhitensAndJacobians) {
   std::vector<std::vector<double>> blocks = {

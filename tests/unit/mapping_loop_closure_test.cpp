@@ -12,6 +12,7 @@
 
 #include "mapping/loop_closure.hpp"
 #include "odometry/error.hpp"
+#include "support/kitti_camera.hpp"
 
 namespace gvio::mapping {
 namespace {
@@ -22,17 +23,7 @@ constexpr double kSpeed = 10.0;   // m/s
 constexpr double kPeriod = 24.0;  // repetition along the road in the repeated world (m)
 
 CameraModel camera() {
-  CameraModel c;
-  c.width_px = 1241;
-  c.height_px = 376;
-  c.fx = c.fy = 718.856;
-  c.cx = 607.19;
-  c.cy = 185.22;
-  Eigen::Matrix3d R;
-  R << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // camera x right, y down, z forward; body x fwd, z up
-  c.T_b_c.linear() = R;
-  c.T_b_c.translation() = Eigen::Vector3d(1.0, 0.0, 0.7);
-  return c;
+  return test::kittiForwardCamera();
 }
 
 Eigen::Isometry3d poseAt(double s) {  // arc length s on the circle, heading along it

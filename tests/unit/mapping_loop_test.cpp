@@ -14,23 +14,13 @@
 #include "mapping/loop_verification.hpp"
 #include "odometry/error.hpp"
 #include "odometry/lie.hpp"
+#include "support/kitti_camera.hpp"
 
 namespace gvio::mapping {
 namespace {
 
 CameraModel kittiLikeCamera() {
-  CameraModel c;
-  c.width_px = 1241;
-  c.height_px = 376;
-  c.fx = c.fy = 718.856;
-  c.cx = 607.19;
-  c.cy = 185.22;
-  // Camera x right, y down, z forward in a body with x forward, y left, z up.
-  Eigen::Matrix3d R;
-  R << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-  c.T_b_c.linear() = R;
-  c.T_b_c.translation() = Eigen::Vector3d(1.0, 0.0, 0.7);
-  return c;
+  return test::kittiForwardCamera();
 }
 
 cv::Mat randomImage(std::uint64_t seed) {
