@@ -22,7 +22,7 @@ struct SimRequest {
   std::string trajectory_format = "auto";  // auto|tum|kitti (KITTI = odometry cam0 poses)
   std::optional<std::filesystem::path> times;
   // Where the body's orientation comes from: the file's (checked against the direction of travel,
-  // with a warning) or derived from the path (heading from the velocity, pitch from the climb).
+  // with a warning) or derived from the path (heading and pitch from the direction of travel).
   OrientationSource orientation = OrientationSource::kFile;
   io::DatasetFormat output = io::DatasetFormat::kKittiRaw;  // kitti-raw or euroc
   std::optional<double> seconds;                            // simulate only the first S seconds
