@@ -17,6 +17,7 @@ struct SimulateCliOptions {
   std::string format = "kitti-raw", camera = "stereo", gnss = "spp";
   std::vector<std::string> outages;
   std::optional<std::string> times, world_style;
+  std::string orientation = "file";
   std::string trajectory, out;
   ConfigOptions config;
 };
@@ -45,7 +46,13 @@ int runSimulate(SimulateCliOptions& o, const CommonOptions& common) {
     }
     config.sim.world_style = *o.world_style;
   }
+  const auto orientation = sim::parseOrientationSource(o.orientation);
+  if (!orientation) {  // as --world-style: one line, exit 2
+    throw gvio::InvalidInput(fmt::format("--orientation '{}': expected {}", o.orientation,
+                                         sim::kOrientationSourceNames));
+  }
   sim::SimRequest& r = o.request;
+  r.orientation = *orientation;
   r.config_yaml = dumpConfigYaml(config);
   r.trajectory = o.trajectory;
   r.out = o.out;
@@ -93,6 +100,10 @@ Command addSimulateCommand(CLI::App& app, const CommonOptions& common) {
                   "auto guesses from the first line")
       ->check(CLI::IsMember({"auto", "tum", "kitti"}));
   sub->add_option("--times", o->times, "Times file of a KITTI trajectory (seconds per line)");
+  sub->add_option("--orientation", o->orientation,
+                  "file (default): the file's body orientation, warned about when its x axis is "
+                  "not the direction of travel; motion: a vehicle's, heading from the direction of "
+                  "travel, pitch from the climb, roll zero");
   sub->add_option("--format", o->format, "Output layout")
       ->check(CLI::IsMember({"kitti-raw", "euroc"}));
   sub->add_option("--seconds", o->request.seconds, "Simulate only the first S seconds");

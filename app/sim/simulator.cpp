@@ -52,6 +52,25 @@ void prepareOutput(const SimRequest& r) {
   if (ec) throw io::InputError(r.out, 0, "cannot create the output folder: " + ec.message());
 }
 
+// The simulator mounts its cameras on a vehicle body (x forward). A file whose body is mounted
+// another way would silently point them sideways, so it is checked; motion replaces it.
+Trajectory applyOrientationSource(const Trajectory& T_w_b, const SimRequest& r,
+                                  const SimConfig& c) {
+  MotionOrientationOptions motion;
+  motion.fit = {c.knot_spacing_s, c.smoothing};  // the drive's own spline
+  const FitOptions& fit = motion.fit;
+  if (r.orientation == OrientationSource::kFile) {
+    const auto warning = forwardAxisWarning(checkForwardAxis(T_w_b, fit), r.trajectory.string());
+    if (warning) spdlog::warn("{}", *warning);
+    return T_w_b;
+  }
+  try {
+    return orientationFromMotion(T_w_b, motion);
+  } catch (const InvalidInput& e) {
+    throw InvalidInput(fmt::format("--trajectory {}: {}", r.trajectory.string(), e.what()));
+  }
+}
+
 Trajectory loadBodyPoses(const SimRequest& r, const SimConfig& c) {
   const io::TrajectoryFormat f = r.trajectory_format == "auto"
                                      ? io::detectTrajectoryFormat(r.trajectory)
@@ -66,6 +85,7 @@ Trajectory loadBodyPoses(const SimRequest& r, const SimConfig& c) {
     throw io::InputError(r.trajectory, 0,
                          fmt::format("{} poses; at least 4 are needed", poses.size()));
   if (f == io::TrajectoryFormat::kKitti) poses = kittiCameraToEnuBody(poses, c.heading_deg);
+  poses = applyOrientationSource(poses, r, c);
   if (poses.t_ns.front() < kAbsoluteAfterNs) {
     const std::int64_t shift = kDefaultStartNs - poses.t_ns.front();
     for (auto& t : poses.t_ns) t += shift;
@@ -118,6 +138,7 @@ void writeSimYaml(const fs::path& file, const SimRequest& r, const SimSummary& s
   y << YAML::BeginMap << YAML::Key << "generator" << YAML::Value << "gvio simulate";
   y << YAML::Key << "seed" << YAML::Value << r.seed;
   y << YAML::Key << "trajectory" << YAML::Value << r.trajectory.filename().string();
+  y << YAML::Key << "orientation" << YAML::Value << toString(r.orientation);
   y << YAML::Key << "format" << YAML::Value << io::toString(r.output);
   y << YAML::Key << "camera" << YAML::Value << (r.stereo ? "stereo" : "mono");
   y << YAML::Key << "gnss_noise" << YAML::Value << toString(r.gnss);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "io/dataset.hpp"
+#include "sim/body_orientation.hpp"
 #include "sim/gnss_synth.hpp"
 #include "sim/imu_synth.hpp"
 #include "sim/sim_config.hpp"
@@ -20,6 +21,9 @@ struct SimRequest {
   std::filesystem::path trajectory;
   std::string trajectory_format = "auto";  // auto|tum|kitti (KITTI = odometry cam0 poses)
   std::optional<std::filesystem::path> times;
+  // Where the body's orientation comes from: the file's (checked against the direction of travel,
+  // with a warning) or derived from the path (heading and pitch from the direction of travel).
+  OrientationSource orientation = OrientationSource::kFile;
   io::DatasetFormat output = io::DatasetFormat::kKittiRaw;  // kitti-raw or euroc
   std::optional<double> seconds;                            // simulate only the first S seconds
   bool stereo = true;
