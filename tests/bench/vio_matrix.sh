@@ -1,0 +1,255 @@
+#!/usr/bin/env bash
+# VIO across worlds: runs the pure odometry (no GNSS, no map, no loop closure) over a matrix of
+# simulated world styles x seeds and prints one table (APE RMSE after SE(3) alignment, as metres
+# and as % of the path length, keyframes/frames, tracking + estimator ms per frame) per VIO mode,
+# a worst-seed row per style and how many stereo+IMU cells meet the target APE <= 0.10 % of the
+# distance. A benchmark, not a test: nothing asserts; a cell that fails (or never initialises) is
+# shown as such with its exit code and the matrix goes on.
+#
+# Drives: BENCH_SECONDS (default 60) of BENCH_TRAJECTORY (TUM, or KITTI with BENCH_TIMES), else of
+# KITTI-00 ground truth when ../shared/data has it, starting (seed - 1) x BENCH_START_STRIDE s
+# (default 150) into it (wrapped to fit), so that each seed drives other streets; else of the
+# embedded assets/demo/drive.tum (35 s: shorter drives). Each is simulated once into
+# GVIO_BENCH_CACHE (default build/bench_cache) with SPP GNSS, `--world-style STYLE`, `--seed SEED`
+# and the IMU noise drawn per drive in BENCH_IMU_RANGE (MIN:MAX, default 0.5:2; the estimator
+# assumes imu.*: KITTI's oxts cannot state the drive's noise).
+#
+#   tests/bench/vio_matrix.sh                                   # 5 styles x 3 seeds x 3 modes
+#   BENCH_STYLES="street open_road" BENCH_SEEDS="1 2" BENCH_SECONDS=30 tests/bench/vio_matrix.sh
+#   BENCH_RESUME=1 tests/bench/vio_matrix.sh      # keep cells that already finished
+#   BENCH_TABLE_ONLY=1 tests/bench/vio_matrix.sh  # print the table of what BENCH_OUT holds
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+BUILD_DIR="${BUILD_DIR:-build}"
+GVIO="$BUILD_DIR/app/gvio"
+DATA="${GVIO_SHARED_DATA:-../shared/data}/kitti00"
+STYLES="${BENCH_STYLES:-street open_road sparse_texture repetitive vegetation}"
+SEEDS="${BENCH_SEEDS:-1 2 3}"
+MODES="${BENCH_MODES:-stereo-imu stereo mono-imu}"
+DRIVE_S="${BENCH_SECONDS:-60}"
+STRIDE_S="${BENCH_START_STRIDE:-150}"
+IMU_RANGE="${BENCH_IMU_RANGE:-0.5:2}"
+CACHE_ROOT="${GVIO_BENCH_CACHE:-$BUILD_DIR/bench_cache}"
+OUT="${BENCH_OUT:-out/bench/vio_matrix}"
+IFS=: read -r IMU_MIN IMU_MAX <<< "$IMU_RANGE"
+if [ -z "${IMU_MIN:-}" ] || [ -z "${IMU_MAX:-}" ]; then
+  echo "bench: BENCH_IMU_RANGE must be MIN:MAX, not '$IMU_RANGE'" >&2
+  exit 2
+fi
+
+# The trajectory: a window of KITTI-00 per seed, or one file for every seed.
+TRAJ_KIND="file"
+TRAJ=""
+TIMES=""
+if [ -n "${BENCH_TRAJECTORY:-}" ]; then
+  TRAJ="$BENCH_TRAJECTORY"
+  TIMES="${BENCH_TIMES:-}"
+elif [ -f "$DATA/KITTI_00_gt.txt" ] && [ -f "$DATA/KITTI_00_gt_times.txt" ]; then
+  TRAJ_KIND=kitti00
+else
+  TRAJ="assets/demo/drive.tum"
+  echo "bench: $DATA absent: driving assets/demo/drive.tum (35 s, the same route for every seed)" >&2
+fi
+TRAJ_TAG=kitti00
+if [ "$TRAJ_KIND" = file ]; then
+  TRAJ_TAG="$(basename "$TRAJ")"
+  TRAJ_TAG="${TRAJ_TAG%.*}"
+  TRAJ_TAG="${TRAJ_TAG//[^A-Za-z0-9_-]/_}"
+fi
+
+# Start of seed SEED's window into KITTI-00 (s): (seed - 1) x stride, wrapped into the drive.
+kitti_start() {
+  python3 - "$DATA/KITTI_00_gt_times.txt" "$1" "$STRIDE_S" "$DRIVE_S" <<'PY'
+import sys
+times = [float(l) for l in open(sys.argv[1]) if l.strip()]
+seed, stride, dur = int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+span = max(times[-1] - times[0] - dur, 0.0)
+start = ((seed - 1) * stride) % span if span > 0 else 0.0
+print(f"{start:g}")
+PY
+}
+
+# Simulates one drive into the cache (once); prints nothing, returns the simulator's exit code.
+simulate_drive() {
+  local style=$1 seed=$2 start=$3 cache=$4
+  [ -f "$cache/sim.yaml" ] && return 0
+  local traj=("--trajectory" "$TRAJ") tmp=""
+  [ -n "$TIMES" ] && traj+=(--times "$TIMES")
+  if [ "$TRAJ_KIND" = kitti00 ]; then
+    # The window as its own KITTI trajectory (poses in KITTI-00's world; the simulator starts the
+    # stamps at its default epoch), in a temporary folder: no copy of the shared data stays.
+    tmp="$(mktemp -d)"
+    python3 - "$DATA/KITTI_00_gt.txt" "$DATA/KITTI_00_gt_times.txt" "$start" "$tmp" <<'PY'
+import os, sys
+poses = open(sys.argv[1]).read().splitlines()
+times = open(sys.argv[2]).read().splitlines()
+start = float(sys.argv[3])
+keep = [i for i, t in enumerate(times) if t.strip() and float(t) >= start - 1e-9]
+with open(os.path.join(sys.argv[4], "kitti00_window.txt"), "w") as f:
+    f.write("".join(poses[i] + "\n" for i in keep))
+with open(os.path.join(sys.argv[4], "kitti00_window_times.txt"), "w") as f:
+    f.write("".join(times[i] + "\n" for i in keep))
+PY
+    traj=(--trajectory "$tmp/kitti00_window.txt" --times "$tmp/kitti00_window_times.txt")
+  fi
+  echo "bench: simulating $style seed $seed (${DRIVE_S} s from ${start} s) into $cache" >&2
+  rm -rf "$cache.partial"
+  mkdir -p "$cache.partial"
+  local rc=0
+  "$GVIO" simulate "${traj[@]}" --gnss-noise spp --seed "$seed" --seconds "$DRIVE_S" \
+    --world-style "$style" --set "sim.imu_noise_scale_min=$IMU_MIN" \
+    --set "sim.imu_noise_scale_max=$IMU_MAX" --out "$cache.partial" --force --no-progress \
+    > "$cache.partial/simulate.log" 2>&1 || rc=$?
+  [ -n "$tmp" ] && rm -rf "$tmp"
+  if [ "$rc" -ne 0 ]; then
+    echo "bench: simulation failed (exit $rc): $cache.partial/simulate.log" >&2
+    return "$rc"
+  fi
+  echo "trajectory: ${TRAJ_TAG} start_s: ${start} seconds: ${DRIVE_S}" > "$cache.partial/bench_drive.txt"
+  rm -rf "$cache"
+  mv "$cache.partial" "$cache"
+}
+
+if [ -z "${BENCH_TABLE_ONLY:-}" ]; then
+  [ -x "$GVIO" ] || { echo "bench: $GVIO not built (./setup.sh build)" >&2; exit 2; }
+  mkdir -p "$OUT"
+  for style in $STYLES; do
+    for seed in $SEEDS; do
+      start=0
+      [ "$TRAJ_KIND" = kitti00 ] && start="$(kitti_start "$seed")"
+      cache="$CACHE_ROOT/vio_matrix_${TRAJ_TAG}_t${start}_${DRIVE_S}s_${style}_seed${seed}_imu${IMU_MIN}-${IMU_MAX}"
+      cell="$OUT/${style}_seed${seed}"
+      mkdir -p "$cell"
+      echo "$cache" > "$cell/drive.txt"
+      echo "$start" > "$cell/start_s.txt"
+      sim_rc=0
+      simulate_drive "$style" "$seed" "$start" "$cache" || sim_rc=$?
+      echo "$sim_rc" > "$cell/simulate_rc.txt"
+      for mode in $MODES; do
+        run="$cell/$mode"
+        if [ -n "${BENCH_RESUME:-}" ] && [ -f "$run/rc.txt" ]; then continue; fi
+        rm -rf "$run"
+        mkdir -p "$run"
+        if [ "$sim_rc" -ne 0 ]; then
+          echo "simulate $sim_rc" > "$run/rc.txt"
+          continue
+        fi
+        echo "bench: $style seed $seed $mode" >&2
+        run_rc=0
+        "$GVIO" run --dataset "$cache" --gnss off --set "vio.mode=$mode" --set map.enabled=false \
+          --set loops.enabled=false --out "$run" --no-progress > "$run/run.log" 2>&1 || run_rc=$?
+        eval_rc=-1
+        if [ "$run_rc" -eq 0 ] && [ -s "$run/trajectory_vio.tum" ]; then
+          eval_rc=0
+          "$GVIO" eval --ref "$cache/groundtruth.tum" --est "$run/trajectory_vio.tum" --align se3 \
+            --json "$run/eval.json" > "$run/eval.log" 2>&1 || eval_rc=$?
+        fi
+        echo "run $run_rc eval $eval_rc" > "$run/rc.txt"
+      done
+    done
+  done
+fi
+
+python3 - "$OUT" "$CACHE_ROOT" "$DRIVE_S" "$IMU_RANGE" "$TRAJ_TAG" "$STYLES" "$SEEDS" "$MODES" <<'PY'
+import json, os, re, sys
+out, cache_root, drive_s, imu_range, traj_tag = sys.argv[1:6]
+styles, seeds, modes = sys.argv[6].split(), sys.argv[7].split(), sys.argv[8].split()
+TARGET = 0.10  # % of the distance, stereo+IMU
+
+def load(path):
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
+
+def read(path, default=""):
+    try:
+        with open(path) as f:
+            return f.read().strip()
+    except OSError:
+        return default
+
+def drive_info(cell):
+    """Start, truth path length and the drive's IMU noise factors, from the cached drive."""
+    cache = read(os.path.join(cell, "drive.txt"))
+    sim = read(os.path.join(cache, "sim.yaml")) if cache else ""
+    length = re.search(r"^\s*path_length_m:\s*([0-9.eE+-]+)", sim, re.M)
+    scale = re.search(r"^\s*scale:\s*\[([^\]]*)\]", sim, re.M)
+    factors = [float(x) for x in scale.group(1).split(",")] if scale else []
+    return (read(os.path.join(cell, "start_s.txt"), "?"),
+            float(length.group(1)) if length else None, factors)
+
+def cell_result(run):
+    """(sort key: APE % or inf, the table cells for this mode)."""
+    rc = read(os.path.join(run, "rc.txt"))
+    if not rc:
+        return float("inf"), ["not run", "", "", ""]
+    words = rc.split()
+    if words[0] == "simulate":
+        return float("inf"), [f"simulation failed (exit {words[1]})", "", "", ""]
+    run_rc, eval_rc = int(words[1]), int(words[3])
+    rep = load(os.path.join(run, "report.json"))
+    counts = rep.get("counts", {}) if rep else {}
+    kf = (f'{counts.get("keyframes", "?")}/{counts.get("frames", "?")}' if rep else "")
+    t = rep.get("timing_ms", {}) if rep else {}
+    ms = (f'{t["tracking"]["mean"] + t["estimator"]["mean"]:.1f}'
+          if "tracking" in t and "estimator" in t else "")
+    if run_rc != 0:
+        return float("inf"), [f"run failed (exit {run_rc})", "", kf, ms]
+    if not counts.get("poses_written"):
+        return float("inf"), ["never initialised", "", kf, ms]
+    ev = load(os.path.join(run, "eval.json"))
+    if eval_rc != 0 or not ev:
+        return float("inf"), [f"eval failed (exit {eval_rc})", "", kf, ms]
+    rmse = ev["ape"]["rmse"]
+    length = rep.get("evaluation", {}).get("path_length_m")
+    if not length:
+        return float("inf"), [f"{rmse:.3f}", "no path length", kf, ms]
+    pct = 100.0 * rmse / length
+    late = ""
+    if counts.get("poses_written") and counts.get("frames"):
+        share = counts["poses_written"] / counts["frames"]
+        if share < 0.9:  # a late initialisation: the APE covers only part of the drive
+            late = f" ({100 * share:.0f} % of frames)"
+    return pct, [f"{rmse:.3f}{late}", f"{pct:.3f}", kf, ms]
+
+head = ["style", "seed", "start (s)", "path (m)", "IMU noise x"]
+for m in modes:
+    head += [f"{m} APE (m)", f"{m} APE %", f"{m} KF/frames", f"{m} ms/frame"]
+print(f"VIO across worlds: {drive_s} s drives of {traj_tag}, IMU noise x{imu_range.replace(':', '-')} "
+      f"per drive, SE(3)-aligned APE RMSE, no GNSS / map / loops; target stereo-imu APE <= "
+      f"{TARGET:.2f} % of the path")
+print()
+print("| " + " | ".join(head) + " |")
+print("|" + " --- |" * len(head))
+stereo_imu = []  # (pct, style, seed)
+for style in styles:
+    worst = {m: (float("-inf"), "") for m in modes}
+    for seed in seeds:
+        cell = os.path.join(out, f"{style}_seed{seed}")
+        start, length, factors = drive_info(cell)
+        imu = f"{min(factors):.2f}-{max(factors):.2f}" if factors else ""
+        row = [style, seed, start, f"{length:.0f}" if length else "", imu]
+        for m in modes:
+            pct, cells = cell_result(os.path.join(cell, m))
+            row += cells
+            if pct > worst[m][0]:
+                worst[m] = (pct, f"{cells[1] or cells[0]} (seed {seed})")
+            if m == "stereo-imu":
+                stereo_imu.append((pct, style, seed))
+        print("| " + " | ".join(row) + " |")
+    row = [f"**{style} worst**", "", "", "", ""]
+    for m in modes:
+        row += ["", f"**{worst[m][1]}**", "", ""]
+    print("| " + " | ".join(row) + " |")
+print()
+if stereo_imu:
+    met = sum(1 for p, _, _ in stereo_imu if p <= TARGET)
+    p, style, seed = max(stereo_imu)
+    shown = f"{p:.3f} %" if p != float("inf") else "failed"
+    print(f"stereo-imu: {met} of {len(stereo_imu)} cells meet APE <= {TARGET:.2f} % of the path; "
+          f"worst cell: {style} seed {seed} ({shown})")
+else:
+    print("stereo-imu not in BENCH_MODES: no target line")
+PY
