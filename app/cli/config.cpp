@@ -320,6 +320,8 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       text("sim.world_style", c.sim.world_style),
       number("sim.imu_noise_scale_min", c.sim.imu_noise_scale_min),
       number("sim.imu_noise_scale_max", c.sim.imu_noise_scale_max),
+      number("sim.imu_turn_on_acc_bias_mps2", c.sim.imu_turn_on_acc_bias_mps2),
+      number("sim.imu_turn_on_gyr_bias_radps", c.sim.imu_turn_on_gyr_bias_radps),
   };
 }
 

@@ -75,6 +75,19 @@ ImuNoiseDraw drawImuNoise(const ImuNoise& nominal, double scale_min, double scal
   return draw;
 }
 
+TurnOnBias drawTurnOnBias(double acc_sigma_mps2, double gyr_sigma_radps, std::uint64_t seed) {
+  if (!(acc_sigma_mps2 >= 0.0) || !(gyr_sigma_radps >= 0.0) || !std::isfinite(acc_sigma_mps2) ||
+      !std::isfinite(gyr_sigma_radps)) {
+    throw InvalidInput("imu turn-on bias: sigmas must be finite and >= 0");
+  }
+  Rng rng(seed);
+  TurnOnBias bias;
+  // Always draw both, so that one sigma does not change the other's values.
+  bias.acc_mps2 = acc_sigma_mps2 * rng.normal3();
+  bias.gyr_radps = gyr_sigma_radps * rng.normal3();
+  return bias;
+}
+
 // Discrete-time IMU noise model (Kalibr IMU noise model wiki; Nikolic et al. 2016): white noise
 // sigma_d = sigma_c * sqrt(rate) and bias random walk b_{k+1} = b_k + sigma_bc * sqrt(dt) * n_k,
 // n_k ~ N(0, I); measured = truth + b_k + sigma_d * w_k.

@@ -35,6 +35,14 @@ struct ImuNoiseDraw {
 ImuNoiseDraw drawImuNoise(const ImuNoise& nominal, double scale_min, double scale_max,
                           std::uint64_t seed);
 
+// One drive's turn-on biases: each axis N(0, sigma^2) by seed (a MEMS IMU starts every drive with
+// another bias, which a filter must estimate; 0 sigma: none).
+struct TurnOnBias {
+  Eigen::Vector3d acc_mps2 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyr_radps = Eigen::Vector3d::Zero();
+};
+TurnOnBias drawTurnOnBias(double acc_sigma_mps2, double gyr_sigma_radps, std::uint64_t seed);
+
 // Samples [t0, t1] of `trajectory` at the rate; deterministic for a seed.
 std::vector<ImuSimSample> synthesizeImu(const ContinuousTrajectory& trajectory,
                                         const ImuSimOptions& options, std::uint64_t seed);

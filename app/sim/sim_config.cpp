@@ -51,6 +51,10 @@ void SimConfig::validate() const {
           "in [0.01, 100]", imu_noise_scale_min);
   require(imu_noise_scale_max >= imu_noise_scale_min && imu_noise_scale_max <= 100.0,
           "imu_noise_scale_max", "in [sim.imu_noise_scale_min, 100]", imu_noise_scale_max);
+  require(imu_turn_on_acc_bias_mps2 >= 0.0 && imu_turn_on_acc_bias_mps2 <= 5.0,
+          "imu_turn_on_acc_bias_mps2", "in [0, 5]", imu_turn_on_acc_bias_mps2);
+  require(imu_turn_on_gyr_bias_radps >= 0.0 && imu_turn_on_gyr_bias_radps <= 0.5,
+          "imu_turn_on_gyr_bias_radps", "in [0, 0.5]", imu_turn_on_gyr_bias_radps);
 }
 
 }  // namespace gvio::sim

@@ -33,6 +33,9 @@ struct SimConfig {
   // Per-drive IMU noise: each of the four imu.* densities times its own multiplier, drawn
   // log-uniformly in [min, max] by seed (1, 1: the imu.* values exactly).
   double imu_noise_scale_min = 1.0, imu_noise_scale_max = 1.0;
+  // Per-drive turn-on biases, 1 sigma per axis (0: the IMU starts unbiased).
+  double imu_turn_on_acc_bias_mps2 = 0.0;
+  double imu_turn_on_gyr_bias_radps = 0.0;
 
   void validate() const;  // throws InvalidInput naming the key
 };

@@ -155,7 +155,13 @@ void writeSimYaml(const fs::path& file, const SimRequest& r, const SimSummary& s
   y << YAML::Key << "gyr_random_walk" << YAML::Value << n.gyr_random_walk;
   y << YAML::Key << "scale" << YAML::Value << YAML::Flow << YAML::BeginSeq;
   for (const double scale : s.imu_noise.scale) y << scale;
-  y << YAML::EndSeq << YAML::EndMap;
+  y << YAML::EndSeq;
+  const TurnOnBias& b = s.imu_turn_on_bias;
+  y << YAML::Key << "turn_on_acc_bias_mps2" << YAML::Value << YAML::Flow << YAML::BeginSeq
+    << b.acc_mps2.x() << b.acc_mps2.y() << b.acc_mps2.z() << YAML::EndSeq;
+  y << YAML::Key << "turn_on_gyr_bias_radps" << YAML::Value << YAML::Flow << YAML::BeginSeq
+    << b.gyr_radps.x() << b.gyr_radps.y() << b.gyr_radps.z() << YAML::EndSeq;
+  y << YAML::EndMap;
   y << YAML::Key << "config" << YAML::Value << YAML::Load(r.config_yaml);
   y << YAML::Key << "result" << YAML::Value << YAML::BeginMap;
   y << YAML::Key << "duration_s" << YAML::Value << s.duration_s;
@@ -203,6 +209,10 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
   ImuSimOptions imu_opt;
   imu_opt.rate_hz = config.imu_rate_hz;
   imu_opt.noise = summary.imu_noise.noise;
+  summary.imu_turn_on_bias = drawTurnOnBias(config.imu_turn_on_acc_bias_mps2,
+                                            config.imu_turn_on_gyr_bias_radps, mixSeed(r.seed, 6));
+  imu_opt.initial_acc_bias = summary.imu_turn_on_bias.acc_mps2;
+  imu_opt.initial_gyr_bias = summary.imu_turn_on_bias.gyr_radps;
   std::vector<ImuSimSample> imu = synthesizeImu(traj, imu_opt, mixSeed(r.seed, 1));
   std::erase_if(imu, [&](const ImuSimSample& s) { return s.measured.t_ns > t1; });
   const fusion::EnuFrame enu({config.origin_lat_deg, config.origin_lon_deg, config.origin_h_m});

@@ -39,8 +39,9 @@ struct SimSummary {
   std::size_t frames = 0, imu_samples = 0, gnss_fixes = 0, world_triangles = 0;
   double duration_s = 0.0, path_length_m = 0.0;
   FitReport fit;
-  ImuNoiseDraw imu_noise;  // the drive's IMU noise (sim.imu_noise_scale_*)
-  std::string egl;         // EGL path and renderer used
+  ImuNoiseDraw imu_noise;       // the drive's IMU noise (sim.imu_noise_scale_*)
+  TurnOnBias imu_turn_on_bias;  // its biases at the start (sim.imu_turn_on_*)
+  std::string egl;              // EGL path and renderer used
 };
 
 using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;

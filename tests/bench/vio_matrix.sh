@@ -12,7 +12,8 @@
 # embedded assets/demo/drive.tum (35 s: shorter drives). Each is simulated once into
 # GVIO_BENCH_CACHE (default build/bench_cache) with SPP GNSS, `--world-style STYLE`, `--seed SEED`
 # and the IMU noise drawn per drive in BENCH_IMU_RANGE (MIN:MAX, default 0.5:2; the estimator
-# assumes imu.*: KITTI's oxts cannot state the drive's noise).
+# assumes imu.*: KITTI's oxts cannot state the drive's noise) and, with BENCH_TURN_ON (ACC:GYR,
+# 1-sigma per axis in m/s^2 and rad/s; default none), turn-on biases drawn per drive.
 #
 #   tests/bench/vio_matrix.sh                                   # 5 styles x 3 seeds x 3 modes
 #   BENCH_STYLES="street open_road" BENCH_SEEDS="1 2" BENCH_SECONDS=30 tests/bench/vio_matrix.sh
@@ -29,6 +30,19 @@ MODES="${BENCH_MODES:-stereo-imu stereo mono-imu}"
 DRIVE_S="${BENCH_SECONDS:-60}"
 STRIDE_S="${BENCH_START_STRIDE:-150}"
 IMU_RANGE="${BENCH_IMU_RANGE:-0.5:2}"
+TURN_ON="${BENCH_TURN_ON:-}"
+TURN_ON_SET=()
+TURN_ON_TAG=""
+if [ -n "$TURN_ON" ]; then
+  IFS=: read -r TURN_ACC TURN_GYR <<< "$TURN_ON"
+  if [ -z "${TURN_ACC:-}" ] || [ -z "${TURN_GYR:-}" ]; then
+    echo "bench: BENCH_TURN_ON must be ACC:GYR, not '$TURN_ON'" >&2
+    exit 2
+  fi
+  TURN_ON_SET=(--set "sim.imu_turn_on_acc_bias_mps2=$TURN_ACC" --set
+    "sim.imu_turn_on_gyr_bias_radps=$TURN_GYR")
+  TURN_ON_TAG="_bias${TURN_ACC}-${TURN_GYR}"
+fi
 CACHE_ROOT="${GVIO_BENCH_CACHE:-$BUILD_DIR/bench_cache}"
 OUT="${BENCH_OUT:-out/bench/vio_matrix}"
 IFS=: read -r IMU_MIN IMU_MAX <<< "$IMU_RANGE"
@@ -98,7 +112,8 @@ PY
   local rc=0
   "$GVIO" simulate "${traj[@]}" --gnss-noise spp --seed "$seed" --seconds "$DRIVE_S" \
     --world-style "$style" --set "sim.imu_noise_scale_min=$IMU_MIN" \
-    --set "sim.imu_noise_scale_max=$IMU_MAX" --out "$cache.partial" --force --no-progress \
+    --set "sim.imu_noise_scale_max=$IMU_MAX" "${TURN_ON_SET[@]}" --out "$cache.partial" --force \
+    --no-progress \
     > "$cache.partial/simulate.log" 2>&1 || rc=$?
   [ -n "$tmp" ] && rm -rf "$tmp"
   if [ "$rc" -ne 0 ]; then
@@ -117,7 +132,7 @@ if [ -z "${BENCH_TABLE_ONLY:-}" ]; then
     for seed in $SEEDS; do
       start=0
       [ "$TRAJ_KIND" = kitti00 ] && start="$(kitti_start "$seed")"
-      cache="$CACHE_ROOT/vio_matrix_${TRAJ_TAG}_t${start}_${DRIVE_S}s_${style}_seed${seed}_imu${IMU_MIN}-${IMU_MAX}"
+      cache="$CACHE_ROOT/vio_matrix_${TRAJ_TAG}_t${start}_${DRIVE_S}s_${style}_seed${seed}_imu${IMU_MIN}-${IMU_MAX}${TURN_ON_TAG}"
       cell="$OUT/${style}_seed${seed}"
       mkdir -p "$cell"
       echo "$cache" > "$cell/drive.txt"

@@ -297,6 +297,51 @@ TEST_F(SimEndToEnd, ImuNoiseRangeIsDrawnAndRecorded) {
   }
 }
 
+// sim.imu_turn_on_*: the drive's turn-on biases are drawn per seed, stated in sim.yaml and in
+// the IMU data (the mean of measured minus true over 0.3 s); none by default.
+TEST_F(SimEndToEnd, ImuTurnOnBiasIsDrawnRecordedAndInTheData) {
+  const YAML::Node plain = YAML::LoadFile((out() / "sim.yaml").string())["imu_noise"];
+  for (const auto& v : plain["turn_on_acc_bias_mps2"]) EXPECT_EQ(v.as<double>(), 0.0);
+  for (const auto& v : plain["turn_on_gyr_bias_radps"]) EXPECT_EQ(v.as<double>(), 0.0);
+
+  const fs::path out_dir = dir_->path() / "turn_on";
+  const auto r = runGvio(fmt::format(
+      "simulate --trajectory {} --seconds 0.3 --seed 11 --gnss-noise none --set "
+      "sim.imu_turn_on_acc_bias_mps2=0.3 --set sim.imu_turn_on_gyr_bias_radps=0.01 --out {} "
+      "--no-progress",
+      (dir_->path() / "drive.tum").string(), out_dir.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("IMU turn-on bias: acc ["));
+  const YAML::Node drawn = YAML::LoadFile((out_dir / "sim.yaml").string())["imu_noise"];
+  Eigen::Vector3d acc, gyr;
+  for (int i = 0; i < 3; ++i) {
+    acc[i] = drawn["turn_on_acc_bias_mps2"][i].as<double>();
+    gyr[i] = drawn["turn_on_gyr_bias_radps"][i].as<double>();
+  }
+  std::cout << "[ sim ] turn-on acc " << acc.transpose() << " gyr " << gyr.transpose() << "\n";
+  EXPECT_GT(acc.norm(), 0.0);
+  EXPECT_GT(gyr.norm(), 0.0);
+  // Gyro: the body rates of a car over 0.3 s are smooth, so measured minus the truth's finite
+  // rotation rate averages to the bias within the white noise (1.7e-4 rad/s/sqrt(Hz) at 100 Hz
+  // over 30 samples: ~3e-4 rad/s).
+  const io::Dataset ds = io::readDataset(out_dir, std::nullopt, {});
+  const Trajectory gt = io::readTum(out_dir / "groundtruth.tum");  // the body at the IMU rate
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (std::size_t k = 0; k + 1 < gt.size(); ++k) {
+    const double dt = 1e-9 * static_cast<double>(gt.t_ns[k + 1] - gt.t_ns[k]);
+    const Eigen::AngleAxisd step(gt.poses[k].linear().transpose() * gt.poses[k + 1].linear());
+    const auto it = std::find_if(ds.imu.begin(), ds.imu.end(),
+                                 [&](const ImuSample& s) { return s.t_ns == gt.t_ns[k]; });
+    if (it == ds.imu.end() || std::next(it) == ds.imu.end()) continue;
+    const Eigen::Vector3d measured = 0.5 * (it->gyr_b_radps + std::next(it)->gyr_b_radps);
+    sum += measured - step.axis() * step.angle() / dt;
+    ++n;
+  }
+  ASSERT_GT(n, 10);
+  EXPECT_LT((sum / n - gyr).norm(), 1e-3) << (sum / n).transpose();
+}
+
 TEST_F(SimEndToEnd, BadInputIsOneLineExit2) {
   const fs::path d = dir_->path();
   writeText(d / "three.tum", "0 0 0 0 0 0 0 1\n0.1 1 0 0 0 0 0 1\n0.2 2 0 0 0 0 0 1\n");
@@ -322,6 +367,9 @@ TEST_F(SimEndToEnd, BadInputIsOneLineExit2) {
       {"simulate --trajectory " + traj + " --set sim.imu_noise_scale_max=0.5 --out " +
            (d / "x8").string(),
        "sim.imu_noise_scale_max"},
+      {"simulate --trajectory " + traj + " --set sim.imu_turn_on_acc_bias_mps2=-1 --out " +
+           (d / "x9").string(),
+       "sim.imu_turn_on_acc_bias_mps2"},
   };
   for (const auto& [args, needle] : cases) {
     const auto r = runGvio(args + " --no-progress");

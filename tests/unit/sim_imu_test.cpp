@@ -250,5 +250,53 @@ TEST(SimImu, UnitScaleKeepsTheNominalNoiseExactly) {
   EXPECT_THROW((void)drawImuNoise(nominal, 0.0, 1.0, 1), InvalidInput);
 }
 
+// Per-drive turn-on biases (sim.imu_turn_on_*): N(0, sigma^2) per axis by seed, none at sigma 0.
+TEST(SimImu, TurnOnBiasIsReproducibleBySeedWithTheStatedSigma) {
+  const TurnOnBias a = drawTurnOnBias(0.1, 0.002, 3), b = drawTurnOnBias(0.1, 0.002, 3);
+  EXPECT_EQ(a.acc_mps2, b.acc_mps2);
+  EXPECT_EQ(a.gyr_radps, b.gyr_radps);
+  EXPECT_NE(a.acc_mps2, drawTurnOnBias(0.1, 0.002, 4).acc_mps2);
+  // One sigma does not change the other's draw.
+  EXPECT_EQ(drawTurnOnBias(0.0, 0.002, 3).gyr_radps, a.gyr_radps);
+  const TurnOnBias none = drawTurnOnBias(0.0, 0.0, 3);
+  EXPECT_EQ(none.acc_mps2, Eigen::Vector3d::Zero());
+  EXPECT_EQ(none.gyr_radps, Eigen::Vector3d::Zero());
+  double acc2 = 0.0, gyr2 = 0.0;
+  int n = 0;
+  for (std::uint64_t seed = 0; seed < 2000; ++seed) {
+    const TurnOnBias d = drawTurnOnBias(0.1, 0.002, seed);
+    acc2 += d.acc_mps2.squaredNorm();
+    gyr2 += d.gyr_radps.squaredNorm();
+    n += 3;
+  }
+  EXPECT_NEAR(std::sqrt(acc2 / n), 0.1, 0.004);  // 6000 draws: the sample sigma within ~4 %
+  EXPECT_NEAR(std::sqrt(gyr2 / n), 0.002, 0.00008);
+  EXPECT_THROW((void)drawTurnOnBias(-0.1, 0.0, 1), InvalidInput);
+  EXPECT_THROW((void)drawTurnOnBias(0.0, std::nan(""), 1), InvalidInput);
+}
+
+// The drawn bias is where the bias walk starts: in the first sample exactly, and in the mean
+// error of the measurements within the white noise (2 s at 100 Hz: acc ~0.0014 m/s^2, gyr ~1e-4
+// rad/s).
+TEST(SimImu, TurnOnBiasIsInTheMeasurements) {
+  const ContinuousTrajectory drive = carDrive(2.0);
+  ImuSimOptions options;
+  const TurnOnBias bias = drawTurnOnBias(0.2, 0.01, 9);
+  options.initial_acc_bias = bias.acc_mps2;
+  options.initial_gyr_bias = bias.gyr_radps;
+  const auto samples = synthesizeImu(drive, options, 1);
+  ASSERT_FALSE(samples.empty());
+  EXPECT_EQ(samples.front().acc_bias, bias.acc_mps2);
+  EXPECT_EQ(samples.front().gyr_bias, bias.gyr_radps);
+  Eigen::Vector3d acc = Eigen::Vector3d::Zero(), gyr = Eigen::Vector3d::Zero();
+  for (const ImuSimSample& s : samples) {
+    acc += s.measured.acc_b_mps2 - s.truth.acc_b_mps2;
+    gyr += s.measured.gyr_b_radps - s.truth.gyr_b_radps;
+  }
+  const auto n = static_cast<double>(samples.size());
+  EXPECT_LT((acc / n - bias.acc_mps2).norm(), 0.01);
+  EXPECT_LT((gyr / n - bias.gyr_radps).norm(), 1e-3);
+}
+
 }  // namespace
 }  // namespace gvio::sim
