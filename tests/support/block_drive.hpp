@@ -2,12 +2,18 @@
 // The city block the loop-closure tests drive: a rounded 80 x 50 m rectangle (corner radius 12 m)
 // counter-clockwise from the origin heading east, at 8 m/s for 55 s (1.3 laps), body poses at
 // 10 Hz with z up, 0.93 m above the road.
+#include <fmt/format.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <numbers>
+#include <string>
 
+#include "io/trajectory_io.hpp"
 #include "odometry/trajectory.hpp"
+#include "support/fixtures.hpp"
 
 namespace gvio::test {
 
@@ -52,6 +58,18 @@ inline Trajectory blockDrive() {
     t.t_ns.push_back(static_cast<std::int64_t>(i) * 100'000'000LL);
   }
   return t;
+}
+
+// The block drive simulated with SPP-grade GNSS, seed 1 and `extra_args`, once for all test
+// processes: the drive is written to `file_name` in the test cache, a stable path, because the
+// simulation cache is keyed by the arguments.
+inline std::filesystem::path simulatedBlockDrive(const std::string& file_name,
+                                                 const std::string& extra_args = "") {
+  const std::filesystem::path drive = std::filesystem::path(GVIO_TEST_CACHE_DIR) / file_name;
+  std::filesystem::create_directories(drive.parent_path());
+  io::writeTum(drive, blockDrive());
+  return cachedSimulation(
+      fmt::format("--trajectory {} --gnss-noise spp --seed 1{}", quoted(drive), extra_args));
 }
 
 }  // namespace gvio::test

@@ -61,6 +61,10 @@ struct CommandResult {
 inline std::string quoted(const std::filesystem::path& p) {
   return "'" + p.string() + "'";
 }
+// `gvio run` options for the simulator's ENU origin and antenna lever arm (its defaults): the fused
+// trajectory is then directly comparable with groundtruth.tum.
+inline constexpr const char* kSimGeo =
+    "--set fusion.origin=48.98253,8.39035,116.4 --set fusion.lever_arm_b=[0,0,0.8]";
 // Runs the built gvio binary with `args` (shell-quoted by the caller), capturing stdout/stderr.
 CommandResult runGvio(const std::string& args);
 // The output folder of `gvio simulate <args> --out <folder>`, simulated once per build of the gvio

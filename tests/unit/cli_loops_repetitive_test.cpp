@@ -23,8 +23,6 @@ namespace gvio::test {
 namespace {
 namespace fs = std::filesystem;
 
-constexpr const char* kSimGeo =
-    "--set fusion.origin=48.98253,8.39035,116.4 --set fusion.lever_arm_b=[0,0,0.8]";
 constexpr double kSearchRadius_m = 10.0;  // loops.search_radius_m's default
 constexpr double kPairTolerance_m = 0.2;
 
@@ -39,11 +37,7 @@ class CliLoopsRepetitive : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     tmp_ = std::make_unique<TempDir>("cli_loops_repetitive");
-    const fs::path drive = fs::path(GVIO_TEST_CACHE_DIR) / "block_drive_repetitive.tum";
-    fs::create_directories(drive.parent_path());
-    io::writeTum(drive, blockDrive());
-    sim_ = cachedSimulation(fmt::format(
-        "--trajectory {} --gnss-noise spp --seed 1 --world-style repetitive", quoted(drive)));
+    sim_ = simulatedBlockDrive("block_drive_repetitive.tum", " --world-style repetitive");
   }
   static void TearDownTestSuite() { tmp_.reset(); }
 

@@ -21,20 +21,11 @@ namespace gvio::test {
 namespace {
 namespace fs = std::filesystem;
 
-constexpr const char* kSimGeo =
-    "--set fusion.origin=48.98253,8.39035,116.4 --set fusion.lever_arm_b=[0,0,0.8]";
-
 class CliLoops : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     tmp_ = std::make_unique<TempDir>("cli_loops");
-    // A stable path: the simulation cache is keyed by the arguments (ctest runs each test in a
-    // process of its own, and they share one simulation).
-    const fs::path drive = fs::path(GVIO_TEST_CACHE_DIR) / "block_drive.tum";
-    fs::create_directories(drive.parent_path());
-    io::writeTum(drive, blockDrive());
-    sim_ =
-        cachedSimulation(fmt::format("--trajectory {} --gnss-noise spp --seed 1", quoted(drive)));
+    sim_ = simulatedBlockDrive("block_drive.tum");
   }
   static void TearDownTestSuite() { tmp_.reset(); }
 

@@ -33,10 +33,9 @@ class CliMap : public ::testing::Test {
         fmt::format("--trajectory {}/assets/demo/drive.tum --seconds 20 --seed 9 --gnss-noise rtk",
                     GVIO_SOURCE_DIR)));
     tmp_ = new TempDir("cli_map");
-    const CommandResult r = runGvio(
-        fmt::format("run --dataset {} --out {} --no-progress --gnss graph --set "
-                    "fusion.origin=48.98253,8.39035,116.4 --set fusion.lever_arm_b=[0,0,0.8]",
-                    quoted(*dataset_), quoted(run())));
+    const CommandResult r =
+        runGvio(fmt::format("run --dataset {} --out {} --no-progress --gnss graph {}",
+                            quoted(*dataset_), quoted(run()), kSimGeo));
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   static void TearDownTestSuite() {

@@ -16,15 +16,6 @@ namespace gvio::test {
 namespace {
 namespace fs = std::filesystem;
 
-std::string quotedPath(const fs::path& p) {
-  return "'" + p.string() + "'";
-}
-
-// The simulator's ENU origin and antenna lever arm: the fused trajectory is then directly
-// comparable with groundtruth.tum.
-constexpr const char* kSimGeo =
-    "--set fusion.origin=48.98253,8.39035,116.4 --set fusion.lever_arm_b=[0,0,0.8]";
-
 class CliRunGnss : public ::testing::Test {
  protected:
   static fs::path drive(const std::string& extra) {
@@ -33,7 +24,7 @@ class CliRunGnss : public ::testing::Test {
   }
   CommandResult run(const fs::path& dataset, const std::string& gnss, const fs::path& out) {
     return runGvio(fmt::format("run --dataset {} --out {} --no-progress --gnss {} {}",
-                               quotedPath(dataset), quotedPath(out), gnss, kSimGeo));
+                               quoted(dataset), quoted(out), gnss, kSimGeo));
   }
   static nlohmann::json report(const fs::path& out) {
     return nlohmann::json::parse(readText(out / "report.json"));
@@ -148,7 +139,7 @@ TEST_F(CliRunGnss, GnssNoiseFromAFileAndBadSpecs) {
             "white_h_m: 0.5\nwhite_v_m: 1.0\nbias_m: 0.0\noutlier_probability: 0\n"
             "reported_sigma_h_m: 0.5\nreported_sigma_v_m: 1.0\n");
   const fs::path out = tmp_.path() / "file";
-  const CommandResult r = run(dataset, "graph --gnss-noise " + quotedPath(model), out);
+  const CommandResult r = run(dataset, "graph --gnss-noise " + quoted(model), out);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(report(out)["gnss"]["noise_added"]["outliers"], 0);
   EXPECT_NEAR(report(out)["gnss"]["noise_added"]["white_h_m"].get<double>(), 0.5, 1e-12);
@@ -157,8 +148,7 @@ TEST_F(CliRunGnss, GnssNoiseFromAFileAndBadSpecs) {
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.err.find("nosuch.yaml"), std::string::npos) << missing.err;
   writeText(model, "bias_tau_s: -1\n");
-  const CommandResult bad =
-      run(dataset, "graph --gnss-noise " + quotedPath(model), tmp_.path() / "b");
+  const CommandResult bad = run(dataset, "graph --gnss-noise " + quoted(model), tmp_.path() / "b");
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("bias_tau_s"), std::string::npos) << bad.err;
 }
