@@ -79,8 +79,7 @@ int runSimulate(SimulateCliOptions& o, const CommonOptions& common) {
       "walk {:.3g} (x {:.3g}, {:.3g}, {:.3g}, {:.3g} of imu.*)\n",
       n.acc_noise_density, n.gyr_noise_density, n.acc_random_walk, n.gyr_random_walk,
       s.imu_noise.scale[0], s.imu_noise.scale[1], s.imu_noise.scale[2], s.imu_noise.scale[3]);
-  if (config.sim.imu_turn_on_acc_bias_mps2 > 0.0 || config.sim.imu_turn_on_gyr_bias_radps > 0.0) {
-    const auto& b = s.imu_turn_on_bias;
+  if (const auto& b = s.imu_turn_on_bias; !b.acc_mps2.isZero(0.0) || !b.gyr_radps.isZero(0.0)) {
     fmt::print(
         "IMU turn-on bias: acc [{:.3g}, {:.3g}, {:.3g}] m/s^2, gyr [{:.3g}, {:.3g}, {:.3g}] "
         "rad/s\n",
