@@ -82,8 +82,8 @@ KeyframeTimings MapBuilder::addKeyframe(std::int64_t t_ns, const Eigen::Isometry
   }
   timings.ms_sparse = msSince(start);
 
-  const bool dense_turn = index % static_cast<std::size_t>(config_.dense.every_n_keyframes) == 0;
-  if (stereo_ && dense_turn && !left.empty() && !right.empty()) {
+  if (stereo_ && denseTurn(index, T_w_b) && !left.empty() && !right.empty()) {
+    last_dense_T_w_b_ = T_w_b;
     start = Clock::now();
     const CameraCloud points_c =
         voxelDownsample(stereo_->compute(left, right), config_.dense.voxel_size_m);
@@ -92,6 +92,16 @@ KeyframeTimings MapBuilder::addKeyframe(std::int64_t t_ns, const Eigen::Isometry
     timings.dense_points = store_.keyframes()[index].dense_c.size();
   }
   return timings;
+}
+
+bool MapBuilder::denseTurn(std::size_t index, const Eigen::Isometry3d& T_w_b) const {
+  const DenseMapConfig& c = config_.dense;
+  if (index % static_cast<std::size_t>(c.every_n_keyframes) != 0) return false;
+  if (!last_dense_T_w_b_) return true;
+  const Eigen::Isometry3d T_last_b = last_dense_T_w_b_->inverse() * T_w_b;
+  const double moved_m = T_last_b.translation().norm();
+  const double turned_deg = Eigen::AngleAxisd(T_last_b.rotation()).angle() * 180.0 / M_PI;
+  return moved_m >= c.min_spacing_m || turned_deg >= c.min_rotation_deg;
 }
 
 bool MapBuilder::landmarkAccepted(const StoredLandmark& lm) const {
@@ -136,6 +146,17 @@ MapBuildResult MapBuilder::build(const PoseLookup& pose_of) const {
 void MapBuilder::buildOccupancyReleasing(const PoseLookup& pose_of, MapBuildResult& into) {
   MapCounts scratch;  // the placement was counted by buildClouds
   occupancyInto(placedPoses(pose_of, scratch), into, &store_);
+}
+
+void MapBuilder::buildOccupancy(const PoseLookup& pose_of, MapBuildResult& into) const {
+  MapCounts scratch;
+  occupancyInto(placedPoses(pose_of, scratch), into, nullptr);
+}
+
+void MapBuilder::releaseDense() {
+  for (std::size_t i = 0; i < store_.keyframes().size(); ++i) {
+    if (store_.keyframes()[i].has_dense) store_.releaseDense(i);
+  }
 }
 
 std::vector<std::optional<Eigen::Isometry3d>> MapBuilder::placedPoses(const PoseLookup& pose_of,

@@ -69,7 +69,8 @@ class MapBuilder {
   MapBuilder(const MapConfig& config, const CameraModel& left, double baseline_m);
 
   // Records keyframe t_ns with its VIO pose T_w_b: its dense points when the rig is stereo,
-  // `right` is not empty, dense mapping is on and this is an every_n-th keyframe; and the window's
+  // `right` is not empty, dense mapping is on, this is an every_n-th keyframe and it is
+  // min_spacing_m / min_rotation_deg away from the last keyframe with depth; and the window's
   // landmarks (VioEstimator::landmarks()), re-expressed in this keyframe's body frame. Images are
   // the rectified 8-bit pair. Keyframe times must increase.
   KeyframeTimings addKeyframe(std::int64_t t_ns, const Eigen::Isometry3d& T_w_b,
@@ -87,6 +88,11 @@ class MapBuilder {
   // contribute their landmarks only (keyframePoints, build).
   [[nodiscard]] MapBuildResult buildClouds(const PoseLookup& pose_of) const;
   void buildOccupancyReleasing(const PoseLookup& pose_of, MapBuildResult& into);
+  // The same occupancy without freeing anything, so it may run on another thread beside
+  // buildClouds or keyframePoints (all const); then releaseDense() frees the dense points. The
+  // trees are the same as buildOccupancyReleasing's.
+  void buildOccupancy(const PoseLookup& pose_of, MapBuildResult& into) const;
+  void releaseDense();
 
   // Points of the keyframes with t0_ns <= t_ns <= t1_ns in the target frame, without the global
   // filters: dense points where the keyframe has them, else the landmarks attached to it that
@@ -113,6 +119,8 @@ class MapBuilder {
   void occupancyInto(const std::vector<std::optional<Eigen::Isometry3d>>& poses,
                      MapBuildResult& result, KeyframeStore* release) const;
   [[nodiscard]] bool landmarkAccepted(const StoredLandmark& lm) const;
+  // Whether keyframe `index` at T_w_b gets stereo depth (every_n, spacing and rotation rules).
+  [[nodiscard]] bool denseTurn(std::size_t index, const Eigen::Isometry3d& T_w_b) const;
   // The points a keyframe contributes, in the target frame (see keyframePoints).
   [[nodiscard]] CameraCloud pointsOf(std::size_t index, const Eigen::Isometry3d& T_target_b,
                                      const std::vector<std::vector<std::uint64_t>>& attached) const;
@@ -122,6 +130,7 @@ class MapBuilder {
   CameraModel camera_;
   std::unique_ptr<StereoDepth> stereo_;  // null for mono or dense off
   KeyframeStore store_;
+  std::optional<Eigen::Isometry3d> last_dense_T_w_b_;  // the spacing rule's reference
 };
 
 }  // namespace gvio::mapping

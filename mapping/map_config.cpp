@@ -27,6 +27,10 @@ void MapConfig::validate() const {
           "> 0");
 
   require(dense.every_n_keyframes >= 1, "dense.every_n_keyframes", ">= 1");
+  require(std::isfinite(dense.min_spacing_m) && dense.min_spacing_m >= 0.0, "dense.min_spacing_m",
+          ">= 0");
+  require(std::isfinite(dense.min_rotation_deg) && dense.min_rotation_deg >= 0.0,
+          "dense.min_rotation_deg", ">= 0");
   const StereoDepthConfig& s = dense.stereo;
   require(positive(s.downscale) && s.downscale <= 1.0, "dense.stereo.downscale", "in (0, 1]");
   require(s.num_disparities >= 16 && s.num_disparities % 16 == 0, "dense.stereo.num_disparities",

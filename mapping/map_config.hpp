@@ -45,6 +45,16 @@ struct StereoDepthConfig {
 struct DenseMapConfig {
   bool enabled = true;        // dense stereo points (needs a stereo rig)
   int every_n_keyframes = 1;  // stereo depth on every n-th keyframe (1: all; raise to save time)
+  // ... and only once the camera has moved this far, or turned this much, since the last keyframe
+  // with depth (VIO poses). A car at 10 Hz makes nearly every frame a keyframe (~0.8 m apart), and
+  // every surface within the 15 m depth gate would be triangulated ~20 times over: the VoxelGrid
+  // keeps one point per 0.1 m voxel anyway. 1.5 m / 10 deg: each surface is still in ~10 scans;
+  // on a simulated 60 s street drive (372 m) the dense points' median distance to the true
+  // surfaces stays 0.29 m (0.30 at every keyframe: SPP GNSS dominates), with 39 % of the depth
+  // keyframes and 34 % fewer points (thinner surfaces after the VoxelGrid); map build 18.9 ->
+  // 7.9 s. 0 and 0: depth at every (n-th) keyframe.
+  double min_spacing_m = 1.5;
+  double min_rotation_deg = 10.0;
   StereoDepthConfig stereo;
   // Voxel size of the per-keyframe and the final VoxelGrid (issue 8: 0.1 m). Also bounds memory:
   // a keyframe keeps ~20-40 k points at 0.1 m instead of ~100 k raw half-size depth pixels.

@@ -256,6 +256,8 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("map.sparse.max_landmark_reprojection_px", m.sparse.max_landmark_reprojection_px),
       boolean("map.dense.enabled", m.dense.enabled),
       integer("map.dense.every_n_keyframes", m.dense.every_n_keyframes),
+      number("map.dense.min_spacing_m", m.dense.min_spacing_m),
+      number("map.dense.min_rotation_deg", m.dense.min_rotation_deg),
       number("map.dense.voxel_size_m", m.dense.voxel_size_m),
       integer("map.dense.sor_mean_k", m.dense.sor_mean_k),
       number("map.dense.sor_stddev_mul", m.dense.sor_stddev_mul),

@@ -185,6 +185,8 @@ std::pair<cv::Mat, cv::Mat> planePair(const CameraModel& c) {
 TEST(MappingBuilder, DenseCloudIsVoxelDownsampledAndFollowsPoses) {
   MapConfig config;
   config.dense.sor_stddev_mul = 3.0;
+  config.dense.min_spacing_m = 0.0;  // depth at every keyframe, even one that did not move
+  config.dense.min_rotation_deg = 0.0;
   const CameraModel cam = camera();
   MapBuilder builder(config, cam, 0.54);
   const auto [left, right] = planePair(cam);
@@ -257,6 +259,8 @@ TEST(MappingBuilder, DenseCloudIsVoxelDownsampledAndFollowsPoses) {
 TEST(MappingBuilder, EveryNthKeyframeGetsDepth) {
   MapConfig config;
   config.dense.every_n_keyframes = 2;
+  config.dense.min_spacing_m = 0.0;
+  config.dense.min_rotation_deg = 0.0;
   const CameraModel cam = camera();
   MapBuilder builder(config, cam, 0.54);
   const auto [left, right] = planePair(cam);
@@ -267,6 +271,35 @@ TEST(MappingBuilder, EveryNthKeyframeGetsDepth) {
   // Mono builder never computes depth.
   MapBuilder mono(MapConfig{}, cam, 0.0);
   EXPECT_EQ(mono.addKeyframe(1, pose(0, {0, 0, 0}), left, right, {}).dense_points, 0u);
+}
+
+TEST(MappingBuilder, DepthOnlyOnceTheCameraMovedOrTurnedEnough) {
+  MapConfig config;  // the defaults: 1.5 m or 10 deg since the last keyframe with depth
+  const CameraModel cam = camera();
+  MapBuilder builder(config, cam, 0.54);
+  const auto [left, right] = planePair(cam);
+  const auto depth = [&](std::int64_t t, const Eigen::Isometry3d& T_w_b) {
+    return builder.addKeyframe(t, T_w_b, left, right, {}).dense_points > 0;
+  };
+  EXPECT_TRUE(depth(1, pose(0, {0, 0, 0})));        // the first keyframe
+  EXPECT_FALSE(depth(2, pose(0, {0.8, 0, 0})));     // 0.8 m
+  EXPECT_FALSE(depth(3, pose(0, {1.4, 0.3, 0})));   // 1.43 m from the first
+  EXPECT_TRUE(depth(4, pose(0, {1.6, 0, 0})));      // 1.6 m: the new reference
+  EXPECT_FALSE(depth(5, pose(0.15, {2.0, 0, 0})));  // 0.4 m and 8.6 deg from it
+  EXPECT_TRUE(depth(6, pose(0.18, {2.0, 0, 0})));   // 10.3 deg
+  EXPECT_FALSE(depth(7, pose(0.18, {2.0, 0, 0})));  // standing still
+  std::size_t with_depth = 0;
+  for (const auto& kf : builder.store().keyframes()) with_depth += kf.has_dense ? 1 : 0;
+  EXPECT_EQ(with_depth, 3U);
+  // Both rules at 0: every keyframe, standing still or not.
+  config.dense.min_spacing_m = 0.0;
+  config.dense.min_rotation_deg = 0.0;
+  MapBuilder every(config, cam, 0.54);
+  for (std::int64_t t = 1; t <= 3; ++t) {
+    EXPECT_GT(every.addKeyframe(t, pose(0, {0, 0, 0}), left, right, {}).dense_points, 0u);
+  }
+  config.dense.min_spacing_m = -1.0;
+  EXPECT_THROW(config.validate(), InvalidInput);
 }
 
 TEST(MappingBuilder, WallIsOccupiedAndTheSpaceBeforeItFree) {
