@@ -147,6 +147,11 @@ void FeatureTracker::reset() {
   image_size_ = cv::Size();
 }
 
+void FeatureTracker::rewind(std::uint64_t next_id) {
+  reset();
+  next_id_ = next_id;
+}
+
 TrackedFrame FeatureTracker::track(std::int64_t t_ns, const cv::Mat& left, const cv::Mat& right) {
   checkImages(left, right);
   image_size_ = left.size();

@@ -73,6 +73,10 @@ class FeatureTracker {
   // Forgets every track (e.g. after a black frame or a camera dropout); ids keep increasing so
   // that a consumer never confuses a new feature with an old one.
   void reset();
+  // reset(), and the next new feature gets id `next_id`: undoes a frame tracked ahead and then
+  // abandoned (VioEstimator::takeAhead), so the ids are those of a run that never tracked it.
+  void rewind(std::uint64_t next_id);
+  [[nodiscard]] std::uint64_t nextId() const { return next_id_; }
 
  private:
   // Per-feature state carried from one frame to the next (parallel to the output features).

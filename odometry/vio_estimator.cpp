@@ -116,7 +116,7 @@ void VioEstimator::Impl::restart(std::int64_t t_ns, const std::string& kind, con
                                  bool keep_imu_alignment) {
   event(t_ns, kind, why);
   window.clear();
-  tracker.reset();
+  tracker_reset_pending = true;
   if (!keep_imu_alignment) imu_aligned = false;
   coast_start_ns = -1;
   if (keep_imu_alignment && latest.valid) ++counters.initializations;
@@ -263,16 +263,65 @@ void VioEstimator::addImu(const ImuSample& sample) {
 }
 
 FrameResult VioEstimator::addFrame(std::int64_t t_ns, const cv::Mat& left, const cv::Mat& right) {
-  Impl& s = *impl_;
-  ++s.counters.frames;
-  FrameResult r;
-  r.t_ns = t_ns;
-  if (!s.checkTime(t_ns)) return r;
+  if (!beginFrame(t_ns)) {
+    FrameResult r;
+    r.t_ns = t_ns;
+    return r;
+  }
   const auto start = Clock::now();
-  const TrackedFrame tracked = s.tracker.track(t_ns, left, s.geometry.stereo ? right : cv::Mat());
-  const double ms_tracking = msSince(start);
+  const TrackedFrame tracked = trackFrame(t_ns, left, right);
+  return processFrame(t_ns, tracked, msSince(start));
+}
+
+bool VioEstimator::beginFrame(std::int64_t t_ns) {
+  ++impl_->counters.frames;
+  return impl_->checkTime(t_ns);
+}
+
+bool VioEstimator::wouldAccept(std::int64_t t_ns) const {
+  return impl_->last_frame_ns < 0 || t_ns > impl_->last_frame_ns;
+}
+
+TrackedFrame VioEstimator::trackFrame(std::int64_t t_ns, const cv::Mat& left,
+                                      const cv::Mat& right) {
+  Impl& s = *impl_;
+  if (std::exchange(s.tracker_reset_pending, false)) s.tracker.reset();
+  return s.tracker.track(t_ns, left, s.geometry.stereo ? right : cv::Mat());
+}
+
+VioEstimator::TrackAhead VioEstimator::trackAhead(std::int64_t t_ns, const cv::Mat& left,
+                                                  const cv::Mat& right) {
+  Impl& s = *impl_;
+  TrackAhead ahead;
+  ahead.t_ns = t_ns;
+  ahead.next_id_before = s.tracker.nextId();
+  const auto start = Clock::now();
+  ahead.tracked = s.tracker.track(t_ns, left, s.geometry.stereo ? right : cv::Mat());
+  ahead.ms_tracking = msSince(start);
+  return ahead;
+}
+
+TrackedFrame VioEstimator::takeAhead(TrackAhead&& ahead, const cv::Mat& left, const cv::Mat& right,
+                                     double& ms_tracking) {
+  Impl& s = *impl_;
+  if (!std::exchange(s.tracker_reset_pending, false)) {
+    ms_tracking = ahead.ms_tracking;
+    return std::move(ahead.tracked);
+  }
+  // A restart came between: the sequential run reset the tracker before this frame. Undo the
+  // frame tracked ahead (its new ids included) and track it again after the reset.
+  s.tracker.rewind(ahead.next_id_before);
+  const auto start = Clock::now();
+  TrackedFrame tracked = s.tracker.track(ahead.t_ns, left, s.geometry.stereo ? right : cv::Mat());
+  ms_tracking = ahead.ms_tracking + msSince(start);
+  return tracked;
+}
+
+FrameResult VioEstimator::processFrame(std::int64_t t_ns, const TrackedFrame& tracked,
+                                       double ms_tracking) {
+  Impl& s = *impl_;
   const auto start_estimator = Clock::now();
-  r = s.process(t_ns, tracked);
+  FrameResult r = s.process(t_ns, tracked);
   s.last_features = tracked.features;
   r.ms_tracking = ms_tracking;
   r.ms_estimator = msSince(start_estimator);

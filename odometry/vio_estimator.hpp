@@ -82,6 +82,30 @@ class VioEstimator {
   // 8-bit grey images of the calibrated size (right empty in mono mode).
   FrameResult addFrame(std::int64_t t_ns, const cv::Mat& left, const cv::Mat& right = cv::Mat());
 
+  // addFrame in its three steps, for a pipeline that tracks the next frame while this one is
+  // estimated; the results are addFrame's, bit for bit:
+  //   beginFrame(t)  the frame's time checks (false: the frame is ignored, as in addFrame);
+  //   trackFrame     the front end, or takeAhead(trackAhead(...)) for a frame tracked ahead;
+  //   processFrame   the estimator.
+  // trackAhead(t1, ...) may run on another thread while processFrame(t0) runs, and only then: it
+  // touches nothing but the front end, which processFrame never touches. Call it only for the
+  // frame that comes next, when wouldAccept(t1) (which no processFrame changes), and hand its
+  // result to takeAhead after beginFrame(t1): if a restart came between (it resets the front
+  // end), the frame is tracked again after the reset, with the ids it would have had.
+  bool beginFrame(std::int64_t t_ns);
+  [[nodiscard]] bool wouldAccept(std::int64_t t_ns) const;
+  TrackedFrame trackFrame(std::int64_t t_ns, const cv::Mat& left, const cv::Mat& right = cv::Mat());
+  struct TrackAhead {
+    std::int64_t t_ns = 0;
+    TrackedFrame tracked;
+    std::uint64_t next_id_before = 0;
+    double ms_tracking = 0.0;
+  };
+  TrackAhead trackAhead(std::int64_t t_ns, const cv::Mat& left, const cv::Mat& right = cv::Mat());
+  TrackedFrame takeAhead(TrackAhead&& ahead, const cv::Mat& left, const cv::Mat& right,
+                         double& ms_tracking);
+  FrameResult processFrame(std::int64_t t_ns, const TrackedFrame& tracked, double ms_tracking);
+
   // Events since the last call (moved out).
   std::vector<VioEvent> takeEvents();
   [[nodiscard]] const VioCounters& counters() const;

@@ -66,6 +66,9 @@ struct VioEstimator::Impl {
   EstimatorConfig config;
   StereoGeometry geometry;
   FeatureTracker tracker;
+  // restart() asks for the tracker's reset; the next tracking does it (trackFrame, takeAhead), so
+  // that a restart during processFrame never touches a tracker that is tracking ahead.
+  bool tracker_reset_pending = false;
   ImuBuffer imu;
   SlidingWindow window;
   LatestState latest;

@@ -1,13 +1,19 @@
 // gvio run: visual-inertial odometry over a recorded (or simulated) drive, written as a run folder
 // (DESIGN.md section 4). The pipeline and its stages live in app/run (run/pipeline.hpp); this file
 // only turns the command line into a run request.
+#include <algorithm>
 #include <memory>
+#include <thread>
 
 #include "cli/app.hpp"
 #include "run/pipeline.hpp"
 
 namespace gvio::cli {
 namespace {
+
+int defaultThreads() {
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
 
 struct RunOptions {
   std::string dataset;
@@ -17,6 +23,7 @@ struct RunOptions {
   std::uint64_t seed = 1;
   std::string out = "out/run";
   std::optional<std::string> two_pass;
+  int threads = defaultThreads();
   ConfigOptions config;
 };
 
@@ -31,6 +38,7 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
   request.gnss_noise_name = opt.gnss_noise;
   if (opt.gnss_noise != "none") request.gnss_noise = loadGnssNoiseModel(opt.gnss_noise);
   request.seed = opt.seed;
+  request.threads = opt.threads;
   request.out = opt.out;
   request.command_line = common.command_line;
   request.config_yaml = dumpConfigYaml(config);
@@ -72,6 +80,11 @@ Command addRunCommand(CLI::App& app, const CommonOptions& common) {
   sub->add_option("--two-pass", opt->two_pass,
                   "T0:T1,T2:T3: two passes over the same place (seconds since the first frame); "
                   "report.json map.two_pass says how well their map points agree");
+  sub->add_option("--threads", opt->threads,
+                  "Threads (default: the machine's cores); any number gives the same outputs, "
+                  "bit for bit, 1 runs every stage in turn")
+      ->check(CLI::Range(1, 256))
+      ->capture_default_str();
   opt->config.addTo(*sub);
   return {sub, [opt, &common] { return runRun(*opt, common); }};
 }

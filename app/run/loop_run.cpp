@@ -137,12 +137,12 @@ std::vector<mapping::LoopPointInput> loopPoints(const KeyframeInput& kf) {
   std::unordered_map<std::uint64_t, Eigen::Vector3d> landmark_c;
   if (!(kf.baseline_m > 0.0)) {
     const Eigen::Isometry3d T_c_w = (kf.T_w_b * cam.T_b_c).inverse();
-    for (const odometry::LandmarkEstimate& lm : kf.estimator.landmarks()) {
+    for (const odometry::LandmarkEstimate& lm : kf.landmarks) {
       landmark_c.emplace(lm.id, T_c_w * lm.p_w);
     }
   }
   std::vector<mapping::LoopPointInput> points;
-  const std::vector<odometry::Feature>& features = kf.estimator.lastFeatures();
+  const std::vector<odometry::Feature>& features = kf.features;
   points.reserve(features.size());
   for (const odometry::Feature& f : features) {
     mapping::LoopPointInput p;

@@ -5,6 +5,7 @@
 // merged sparse + dense cloud, float32), map.las when the run is georeferenced (the same cloud in
 // UTM, as `gvio export --to las` writes it) and map.bt / map.ot (OctoMap OcTree / ColorOcTree).
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -37,6 +38,12 @@ class MapRecorder {
   void buildOccupancyReleasing(const mapping::PoseLookup& pose_of, mapping::MapBuildResult& into) {
     builder_->buildOccupancyReleasing(pose_of, into);
   }
+  // The occupancy without freeing (safe beside the const looks above on another thread), and the
+  // freeing afterwards.
+  void buildOccupancy(const mapping::PoseLookup& pose_of, mapping::MapBuildResult& into) const {
+    builder_->buildOccupancy(pose_of, into);
+  }
+  void releaseDense() { builder_->releaseDense(); }
   [[nodiscard]] const std::vector<mapping::KeyframeTimings>& timings() const { return timings_; }
 
  private:
@@ -67,8 +74,13 @@ mapping::PoseLookup mapPoses(const MapRecorder& recorder, const Trajectory* fuse
 // written); otherwise the reason is logged and a map.las of an earlier run in `out` is removed.
 // An empty cloud writes no cloud files and warns.
 // `georeferenced`: `fused` is in local ENU (else the VIO world, e.g. loop-closed without GNSS).
+// `alongside`: read-only looks at the keyframes (revisits, --two-pass) that need their dense
+// points; it runs first. `threaded`: `alongside` and then the occupancy run on a thread of their
+// own (nothing freed until it is done: more memory held, less time), while the clouds are built
+// and written on the calling thread; the files are the same either way.
 MapRunResult buildAndWriteMap(MapRecorder& recorder, const Trajectory* fused, bool georeferenced,
-                              const std::filesystem::path& out);
+                              const std::filesystem::path& out, bool threaded = false,
+                              const std::function<void()>& alongside = {});
 
 // report.json's "map": frame, counts, per-keyframe cost of each stage (ms mean/p95/max), memory.
 nlohmann::json mapReport(const MapRecorder& recorder, const MapRunResult& result);

@@ -28,6 +28,9 @@ struct RunRequest {
   std::uint64_t seed = 1;  // of the GNSS degradation
   std::filesystem::path out;
   std::optional<TwoPassSpans> two_pass;
+  // --threads: 1 runs every stage in order on one thread; >= 2 overlaps them (decoding ahead of
+  // the estimator, keyframe work and the map's stages beside it) with the same outputs.
+  int threads = 1;
   std::string command_line;  // report.json
   std::string config_yaml;   // the effective configuration, written as config.yaml
   ProgressFn progress;       // VIO frames done / total; may be empty

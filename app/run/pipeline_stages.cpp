@@ -26,14 +26,17 @@ void runVioStage(RunState& s) {
   if (s.config.loops.detection.enabled) {
     s.loop_recorder.emplace(s.config.loops.detection.features);
   }
-  KeyframeFn on_keyframe;
+  VioRunOptions options;
+  options.progress = s.request.progress;
+  options.threads = s.request.threads;
   if (s.map_recorder || s.loop_recorder) {
-    on_keyframe = [&s](const KeyframeInput& kf) {
+    // Only the keyframe thread touches the recorders until runVio returns.
+    options.on_keyframe = [&s](const KeyframeInput& kf) {
       if (s.map_recorder) s.map_recorder->addKeyframe(kf);
       if (s.loop_recorder) s.loop_recorder->addKeyframe(kf);
     };
   }
-  s.vio = runVio(ds, s.estimator, s.request.progress, on_keyframe);
+  s.vio = runVio(ds, s.estimator, options);
   if (s.request.progress_done) s.request.progress_done();
   if (s.vio.trajectory.empty()) {
     spdlog::warn("the estimator never initialised: trajectory_vio.tum is empty");
@@ -111,14 +114,17 @@ void runMapStage(RunState& s) {
     return;
   }
   const Trajectory* poses = s.final_trajectory.empty() ? nullptr : &s.final_trajectory;
-  // Before the build, which frees the keyframes' dense points.
-  nlohmann::json two_pass_report;
-  if (s.request.two_pass) {
-    two_pass_report = twoPassReport(*s.map_recorder, mapPoses(*s.map_recorder, poses),
-                                    *s.request.two_pass, s.dataset.frames.front().t_ns);
-  }
-  const nlohmann::json revisits = revisitReport(*s.map_recorder, mapPoses(*s.map_recorder, poses));
-  const MapRunResult map = buildAndWriteMap(*s.map_recorder, poses, s.georeferenced, s.request.out);
+  // Before the build frees the keyframes' dense points (beside the occupancy when threaded).
+  nlohmann::json two_pass_report, revisits;
+  const auto looks = [&] {
+    if (s.request.two_pass) {
+      two_pass_report = twoPassReport(*s.map_recorder, mapPoses(*s.map_recorder, poses),
+                                      *s.request.two_pass, s.dataset.frames.front().t_ns);
+    }
+    revisits = revisitReport(*s.map_recorder, mapPoses(*s.map_recorder, poses));
+  };
+  const MapRunResult map = buildAndWriteMap(*s.map_recorder, poses, s.georeferenced, s.request.out,
+                                            s.request.threads >= 2, looks);
   s.map_report = mapReport(*s.map_recorder, map);
   if (s.request.two_pass) s.map_report["two_pass"] = two_pass_report;
   s.map_report["revisits"] = revisits;

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <map>
 #include <optional>
+#include <utility>
 
 #include "io/dataset_summary.hpp"
 #include "io/image_loader.hpp"
@@ -13,6 +14,8 @@
 #include "io/measurement_stream.hpp"
 #include "odometry/error.hpp"
 #include "odometry/rectifier.hpp"
+#include "run/frame_stepper.hpp"
+#include "run/ordered_work.hpp"
 
 namespace gvio::run {
 namespace {
@@ -107,8 +110,52 @@ VioMode chooseVioMode(const std::string& mode, const io::Dataset& ds) {
   return chosen;
 }
 
+namespace {
+
+// A frame's images, decoded and rectified (ahead of the estimator when threaded).
+struct LoadedFrame {
+  bool readable = false;  // both images loaded: else the frame is skipped
+  odometry::RectifiedImages images;
+  double load_ms = 0.0, rectify_ms = 0.0;
+};
+
+LoadedFrame loadFrame(const io::Dataset& ds, const io::FrameRecord& frame, bool stereo,
+                      const odometry::Rectifier& rectifier, UnreadableImages& unreadable) {
+  LoadedFrame f;
+  const auto t_load = Clock::now();
+  std::optional<cv::Mat> left = unreadable.load(frame.image_paths[0], ds.cameras[0]);
+  std::optional<cv::Mat> right;
+  if (left && stereo) right = unreadable.load(frame.image_paths[1], ds.cameras[1]);
+  if (!left || (stereo && !right)) return f;
+  f.load_ms = msSince(t_load);
+  const auto t_rectify = Clock::now();
+  f.images = rectifier.rectify(*left, right ? *right : cv::Mat());
+  f.rectify_ms = msSince(t_rectify);
+  f.readable = true;
+  return f;
+}
+
+// Keyframe work queued with everything it needs, so the estimator never waits for it.
+KeyframeInput keyframeInput(std::int64_t t_ns, const odometry::FrameResult& result,
+                            const odometry::RectifiedImages& images,
+                            const odometry::Rectifier& rectifier,
+                            const odometry::VioEstimator& estimator) {
+  KeyframeInput kf;
+  kf.t_ns = t_ns;
+  kf.T_w_b = result.T_w_b;
+  kf.left = images.left;
+  kf.right = images.right;
+  kf.left_camera = rectifier.left();
+  kf.baseline_m = rectifier.baselineM();
+  kf.landmarks = estimator.landmarks();
+  kf.features = estimator.lastFeatures();
+  return kf;
+}
+
+}  // namespace
+
 VioRunResult runVio(const io::Dataset& ds, odometry::EstimatorConfig config,
-                    const ProgressFn& progress, const KeyframeFn& on_keyframe) {
+                    const VioRunOptions& options) {
   const auto start = Clock::now();
   VioRunResult r;
   r.mode = config.mode;
@@ -123,7 +170,20 @@ VioRunResult runVio(const io::Dataset& ds, odometry::EstimatorConfig config,
   config.tracker.stereo = stereo;
   odometry::VioEstimator estimator(config, rectifier.left(), rectifier.right());
 
-  UnreadableImages unreadable;
+  // Decoding runs ahead by a few frames; the keyframe hook runs behind by a few keyframes (both
+  // queues bound the images held). The estimator's inputs and the hook's order are those of the
+  // single-threaded run.
+  const bool threaded = options.threads >= 2;
+  UnreadableImages unreadable;  // used by the decoding side only
+  Prefetcher<LoadedFrame> frames(threaded, 4, [&](std::size_t i) -> std::optional<LoadedFrame> {
+    if (i >= ds.frames.size()) return std::nullopt;
+    return loadFrame(ds, ds.frames[i], stereo, rectifier, unreadable);
+  });
+  OrderedWorker keyframe_work(threaded, 4);
+  FrameStepper stepper(estimator, threaded);
+  std::optional<LoadedFrame> peeked;  // the frame after the current one, taken early
+  const ProgressFn& progress = options.progress;
+
   io::MeasurementStream stream(ds);
   std::size_t frames_done = 0;
   while (const auto m = stream.next()) {
@@ -139,24 +199,28 @@ VioRunResult runVio(const io::Dataset& ds, odometry::EstimatorConfig config,
     const io::FrameRecord& frame = *std::get<const io::FrameRecord*>(*m);
     if (progress) progress(frames_done, ds.frames.size());
     ++frames_done;
-    const auto t_frame = Clock::now();
-    std::optional<cv::Mat> left = unreadable.load(frame.image_paths[0], ds.cameras[0]);
-    std::optional<cv::Mat> right;
-    if (left && stereo) right = unreadable.load(frame.image_paths[1], ds.cameras[1]);
-    if (!left || (stereo && !right)) {
+    std::optional<LoadedFrame> loaded =
+        peeked ? std::exchange(peeked, std::nullopt) : frames.next();
+    if (!loaded || !loaded->readable) {
       ++r.frames_skipped_unreadable;  // the estimator sees a gap, as after a dropped frame
       continue;
     }
-    const double load_ms = msSince(t_frame);
-    const auto t_rectify = Clock::now();
-    const odometry::RectifiedImages images = rectifier.rectify(*left, right ? *right : cv::Mat());
-    const double rectify_ms = msSince(t_rectify);
-    const odometry::FrameResult result = estimator.addFrame(frame.t_ns, images.left, images.right);
-    r.timings.load_ms.push_back(load_ms);
-    r.timings.rectify_ms.push_back(rectify_ms);
+    // The next frame, decoded already when threaded, is tracked while this one is estimated.
+    const std::size_t index = frames_done - 1;
+    std::optional<FrameStepper::Next> next;
+    if (threaded && index + 1 < ds.frames.size()) {
+      peeked = frames.next();
+      if (peeked && peeked->readable)
+        next = FrameStepper::Next{ds.frames[index + 1].t_ns, &peeked->images};
+    }
+    const odometry::RectifiedImages& images = loaded->images;
+    const odometry::FrameResult result = stepper.step(frame.t_ns, images, next ? &*next : nullptr);
+    r.timings.load_ms.push_back(loaded->load_ms);
+    r.timings.rectify_ms.push_back(loaded->rectify_ms);
     r.timings.tracking_ms.push_back(result.ms_tracking);
     r.timings.estimator_ms.push_back(result.ms_estimator);
-    r.timings.total_ms.push_back(msSince(t_frame));
+    r.timings.total_ms.push_back(loaded->load_ms + loaded->rectify_ms + result.ms_tracking +
+                                 result.ms_estimator);
     appendEvents(estimator, r.events);
     if (!result.initialized) continue;
     // Never write NaN; a stamp that does not increase would break TUM readers' association.
@@ -167,11 +231,12 @@ VioRunResult runVio(const io::Dataset& ds, odometry::EstimatorConfig config,
     if (!r.trajectory.t_ns.empty() && frame.t_ns <= r.trajectory.t_ns.back()) continue;
     r.trajectory.t_ns.push_back(frame.t_ns);
     r.trajectory.poses.push_back(result.T_w_b);
-    if (result.keyframe && on_keyframe) {
-      on_keyframe({frame.t_ns, result.T_w_b, images.left, images.right, rectifier.left(),
-                   rectifier.baselineM(), estimator});
+    if (result.keyframe && options.on_keyframe) {
+      keyframe_work.submit([&options, kf = keyframeInput(frame.t_ns, result, images, rectifier,
+                                                         estimator)] { options.on_keyframe(kf); });
     }
   }
+  keyframe_work.drain();
   if (progress) progress(frames_done, ds.frames.size());
   appendEvents(estimator, r.events);
   unreadable.logSummary();

@@ -47,24 +47,36 @@ struct VioRunResult {
 
 using ProgressFn = std::function<void(std::size_t frames_done, std::size_t frames_total)>;
 
-// What the map needs of a keyframe, handed over as the estimator declares it (initialised, finite
-// pose). The images are the rectified pair (right empty in mono); the references live only for
-// the call.
+// What the map and loop closure need of a keyframe, handed over as the estimator declares it
+// (initialised, finite pose). It owns its data, so the keyframe work may run on another thread
+// while the estimator goes on: the rectified pair (right empty in mono; images are never written
+// after rectification, so they are shared, not copied), the window's landmarks and the front
+// end's features at this frame.
 struct KeyframeInput {
   std::int64_t t_ns = 0;
-  const Eigen::Isometry3d& T_w_b;
-  const cv::Mat& left;
-  const cv::Mat& right;
-  const CameraModel& left_camera;  // rectified
-  double baseline_m = 0.0;         // 0 in mono
-  const odometry::VioEstimator& estimator;
+  Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();
+  cv::Mat left, right;
+  CameraModel left_camera;  // rectified
+  double baseline_m = 0.0;  // 0 in mono
+  std::vector<odometry::LandmarkEstimate> landmarks;
+  std::vector<odometry::Feature> features;
 };
 using KeyframeFn = std::function<void(const KeyframeInput&)>;
+
+struct VioRunOptions {
+  ProgressFn progress;     // may be empty
+  KeyframeFn on_keyframe;  // may be empty; called in keyframe order, from one thread at a time
+  // 1: everything in order on the calling thread. >= 2: image decoding and rectification run
+  // ahead on a thread of their own, and the keyframe hook on another (in keyframe order), while
+  // the calling thread tracks and estimates. The outputs are the same bit for bit: no decision
+  // depends on which thread finishes first.
+  int threads = 1;
+};
 
 // `config.mode` and `config.imu_noise` are the run's (chooseVioMode, dataset or imu.* noise); the
 // tracker's stereo flag is set here from the mode. Throws InvalidInput for cameras the rectifier
 // or estimator refuse; unreadable images only skip their frame (logged once per folder).
 VioRunResult runVio(const io::Dataset& dataset, odometry::EstimatorConfig config,
-                    const ProgressFn& progress = {}, const KeyframeFn& on_keyframe = {});
+                    const VioRunOptions& options = {});
 
 }  // namespace gvio::run
