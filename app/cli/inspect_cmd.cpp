@@ -8,6 +8,7 @@
 #include "cli/app.hpp"
 #include "io/atomic_write.hpp"
 #include "io/dataset_summary.hpp"
+#include "io/gnss_file.hpp"
 #include "io/image_loader.hpp"
 
 namespace gvio::cli {
@@ -17,6 +18,7 @@ struct InspectOptions {
   std::string dataset;
   std::string format = "auto";
   std::optional<std::string> json;
+  std::optional<std::string> gnss_file;
   bool quick = false;
   ConfigOptions config;
 };
@@ -39,8 +41,8 @@ std::size_t checkImages(const io::Dataset& ds, bool quick, ProgressStyle style) 
 
 int runInspect(const InspectOptions& opt, const CommonOptions& common) {
   const AppConfig config = opt.config.load();
-  const io::Dataset ds =
-      io::readDataset(opt.dataset, io::parseDatasetFormat(opt.format), config.dataset);
+  io::Dataset ds = io::readDataset(opt.dataset, io::parseDatasetFormat(opt.format), config.dataset);
+  if (opt.gnss_file) io::useGnssFile(ds, *opt.gnss_file, config.dataset);
   for (const auto& w : ds.warnings) spdlog::warn("{}", w);
   const std::size_t images = checkImages(ds, opt.quick, common.progressStyle());
   const bool dataset_noise = ds.imu_noise && config.imu.prefer_dataset_noise;
@@ -66,6 +68,8 @@ Command addInspectCommand(CLI::App& app, const CommonOptions& common) {
   sub->add_option("--format", opt->format, "Dataset format")
       ->check(CLI::IsMember({"auto", "kitti-raw", "euroc", "nmea", "comma2k19"}));
   sub->add_option("--json", opt->json, "Also write the summary as JSON to this file");
+  sub->add_option("--gnss-file", opt->gnss_file,
+                  "GNSS fixes from this file instead of the dataset's: NMEA, RTKLIB .pos or CSV");
   sub->add_flag("--quick", opt->quick,
                 "Decode only the first frame's images (text files are always fully checked)");
   opt->config.addTo(*sub);

@@ -23,6 +23,7 @@ struct RunOptions {
   std::uint64_t seed = 1;
   std::string out = "out/run";
   std::optional<std::string> two_pass;
+  std::optional<std::string> gnss_file;
   int threads = defaultThreads();
   ConfigOptions config;
 };
@@ -39,6 +40,7 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
   if (opt.gnss_noise != "none") request.gnss_noise = loadGnssNoiseModel(opt.gnss_noise);
   request.seed = opt.seed;
   request.threads = opt.threads;
+  if (opt.gnss_file) request.gnss_file = *opt.gnss_file;
   request.out = opt.out;
   request.command_line = common.command_line;
   request.config_yaml = dumpConfigYaml(config);
@@ -74,6 +76,10 @@ Command addRunCommand(CLI::App& app, const CommonOptions& common) {
                   "Degrade the dataset's GNSS fixes: none, spp, rtk or a YAML noise-model file "
                   "(reproduces SPP-grade GNSS on an RTK-grade recording)")
       ->capture_default_str();
+  sub->add_option("--gnss-file", opt->gnss_file,
+                  "GNSS fixes from this file instead of the dataset's (any format): NMEA 0183, an "
+                  "RTKLIB solution (.pos: GPST/UTC, lat/lon/height or ECEF) or CSV "
+                  "(#timestamp [ns],lat_deg,lon_deg,height_m,sigma_h_m,sigma_v_m)");
   sub->add_option("--seed", opt->seed, "Random seed of --gnss-noise")->capture_default_str();
   sub->add_option("--out", opt->out, "Run folder (created if missing; files in it are replaced)")
       ->capture_default_str();

@@ -139,10 +139,10 @@ void readImu(const fs::path& dir, Dataset& ds) {
   });
 }
 
-// Out-of-range positions and non-positive sigmas are skipped with a counted warning (never
-// used); NaN or malformed numbers are fatal like everywhere else.
-void readGnss(const fs::path& dir, Dataset& ds) {
-  const fs::path file = dir / "data.csv";
+}  // namespace
+
+std::vector<GnssFix> readGnssCsv(const fs::path& file, std::vector<std::string>& warnings) {
+  std::vector<GnssFix> fixes;
   std::size_t skipped = 0, first_skipped_line = 0;
   readStampedCsv(file, 6, [&](std::int64_t t_ns, const auto& f, const LineReader& at) {
     GnssFix fix;
@@ -157,13 +157,21 @@ void readGnss(const fs::path& dir, Dataset& ds) {
       if (skipped++ == 0) first_skipped_line = at.lineNumber();
       return;
     }
-    ds.gnss.push_back(fix);
+    fixes.push_back(fix);
   });
   if (skipped > 0) {
-    ds.warnings.push_back(fmt::format(
+    warnings.push_back(fmt::format(
         "{}: {} fixes with lat/lon out of range or non-positive sigma skipped (first at line {})",
         file.string(), skipped, first_skipped_line));
   }
+  return fixes;
+}
+
+namespace {
+
+void readGnss(const fs::path& dir, Dataset& ds) {
+  const fs::path file = dir / "data.csv";
+  ds.gnss = readGnssCsv(file, ds.warnings);
   ds.gnss_source = file.string();
 }
 

@@ -25,7 +25,8 @@ struct RunRequest {
   // --gnss-noise: its name as given (none, spp, rtk, a file) and the model behind it.
   std::string gnss_noise_name = "none";
   std::optional<sim::GnssErrorModel> gnss_noise;
-  std::uint64_t seed = 1;  // of the GNSS degradation
+  std::uint64_t seed = 1;                          // of the GNSS degradation
+  std::optional<std::filesystem::path> gnss_file;  // --gnss-file: replaces the dataset's fixes
   std::filesystem::path out;
   std::optional<TwoPassSpans> two_pass;
   // --threads: 1 runs every stage in order on one thread; >= 2 overlaps them (decoding ahead of

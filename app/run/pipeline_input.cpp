@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "io/atomic_write.hpp"
+#include "io/gnss_file.hpp"
 #include "io/trajectory_io.hpp"
 #include "odometry/error.hpp"
 #include "run/ins_run.hpp"
@@ -59,6 +60,7 @@ void makeOutputDir(const fs::path& out) {
 
 void loadDataset(RunState& s) {
   s.dataset = io::readDataset(s.request.dataset, s.request.format, s.config.dataset);
+  if (s.request.gnss_file) io::useGnssFile(s.dataset, *s.request.gnss_file, s.config.dataset);
   for (const auto& w : s.dataset.warnings) spdlog::warn("{}", w);
   s.gnss_noise = degradeGnss(s.dataset, s.request);
 }
