@@ -21,20 +21,20 @@ namespace {
 
 // Marginal covariances of the node poses, rotated from the manifold's body-frame tangent
 // (dphi, dp_body) to ENU axes: dtheta = R dphi, dp = R dp_body.
-std::vector<PoseCovariance> nodeCovariances(
-    ceres::Problem& problem, const std::vector<std::array<double, odometry::kPoseAmbient>>& poses) {
+std::vector<PoseCovariance> nodeCovariances(ceres::Problem& problem,
+                                            const std::vector<double*>& poses) {
   ceres::Covariance::Options options;
   options.num_threads = 1;
   ceres::Covariance covariance(options);
   std::vector<std::pair<const double*, const double*>> blocks;
-  for (const auto& p : poses) blocks.emplace_back(p.data(), p.data());
+  for (const double* p : poses) blocks.emplace_back(p, p);
   if (!covariance.Compute(blocks, &problem)) return {};
   std::vector<PoseCovariance> out;
   out.reserve(poses.size());
-  for (const auto& p : poses) {
+  for (const double* p : poses) {
     Eigen::Matrix<double, 6, 6, Eigen::RowMajor> tangent;
-    if (!covariance.GetCovarianceBlockInTangentSpace(p.data(), p.data(), tangent.data())) return {};
-    const Eigen::Matrix3d R = odometry::poseFromBlock(p.data()).rotation();
+    if (!covariance.GetCovarianceBlockInTangentSpace(p, p, tangent.data())) return {};
+    const Eigen::Matrix3d R = odometry::poseFromBlock(p).rotation();
     Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Zero();
     J.topLeftCorner<3, 3>() = R;
     J.bottomRightCorner<3, 3>() = R;
@@ -59,8 +59,15 @@ SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Ve
                           const RelativeNoise& noise, double huber_sigmas,
                           const SmootherConfig& config) {
   const std::size_t n = fixes.size();
-  std::vector<std::array<double, odometry::kPoseAmbient>> poses(n);
-  std::vector<Eigen::Vector3d> biases(n, Eigen::Vector3d::Zero());
+  // Every parameter block in one buffer, poses then biases: ceres::Covariance orders the blocks
+  // by address, and two separate allocations came in either order from run to run (measured: the
+  // sigmas' last digits differed in one run of a few).
+  std::vector<double> storage(n * (odometry::kPoseAmbient + 3), 0.0);
+  std::vector<double*> poses(n), biases(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    poses[k] = storage.data() + k * odometry::kPoseAmbient;
+    biases[k] = storage.data() + n * odometry::kPoseAmbient + 3 * k;
+  }
   const bool with_bias = config.bias_ratio > 0.0;
   odometry::PoseManifold manifold;
   ceres::HuberLoss loss(huber_sigmas);
@@ -70,28 +77,27 @@ SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Ve
   ceres::Problem problem(popts);
   for (std::size_t k = 0; k < n; ++k) {
     const SmootherFix& f = fixes[k];
-    odometry::poseToBlock(f.T_enu_b, poses[k].data());
-    problem.AddParameterBlock(poses[k].data(), odometry::kPoseAmbient, &manifold);
+    odometry::poseToBlock(f.T_enu_b, poses[k]);
+    problem.AddParameterBlock(poses[k], odometry::kPoseAmbient, &manifold);
     if (with_bias) {
       problem.AddResidualBlock(
           new GnssBiasedPositionFactor(lever_arm_b, f.p_enu, f.sigma_h_m, f.sigma_v_m), &loss,
-          poses[k].data(), biases[k].data());
+          poses[k], biases[k]);
     } else {
       problem.AddResidualBlock(
-          new GnssPositionFactor(lever_arm_b, f.p_enu, f.sigma_h_m, f.sigma_v_m), &loss,
-          poses[k].data());
+          new GnssPositionFactor(lever_arm_b, f.p_enu, f.sigma_h_m, f.sigma_v_m), &loss, poses[k]);
     }
     if (k == 0) continue;
     const Eigen::Isometry3d T_rel = fixes[k - 1].T_w_b.inverse() * f.T_w_b;
     const double dist = T_rel.translation().norm();
     problem.AddResidualBlock(
         new RelativePoseFactor(T_rel, noise.rotationSigmaRad(dist), noise.positionSigmaM(dist)),
-        nullptr, poses[k - 1].data(), poses[k].data());
+        nullptr, poses[k - 1], poses[k]);
     if (with_bias) {
       const double dt = static_cast<double>(f.t_ns - fixes[k - 1].t_ns) * 1e-9;
       problem.AddResidualBlock(
           new GaussMarkovFactor(dt, config.bias_tau_s, config.bias_ratio * f.sigma_h_m), nullptr,
-          biases[k - 1].data(), biases[k].data());
+          biases[k - 1], biases[k]);
     }
   }
   if (with_bias && n > 0) {
@@ -99,14 +105,14 @@ SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Ve
     const Eigen::Matrix3d A =
         Eigen::Matrix3d::Identity() / (config.bias_ratio * fixes.front().sigma_h_m);
     problem.AddResidualBlock(new ceres::NormalPrior(A, Eigen::Vector3d::Zero()), nullptr,
-                             biases[0].data());
+                             biases[0]);
   }
   const ceres::Solver::Options options = batchSolverOptions(config.max_iterations);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   SmoothedNodes out;
   out.T_enu_b.reserve(n);
-  for (const auto& p : poses) out.T_enu_b.push_back(odometry::poseFromBlock(p.data()));
+  for (const double* p : poses) out.T_enu_b.push_back(odometry::poseFromBlock(p));
   out.covariance = nodeCovariances(problem, poses);
   return out;
 }
