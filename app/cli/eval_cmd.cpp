@@ -39,7 +39,20 @@ Trajectory load(const std::string& file, const std::string& format,
       format == "auto" ? io::detectTrajectoryFormat(file) : *io::parseTrajectoryFormat(format);
   std::optional<std::filesystem::path> times_path;
   if (times) times_path = *times;
-  return io::readTrajectory(file, f, times_path);
+  // Stamps as evo takes them: real benchmark files repeat one now and then (TUM RGB-D fr2/desk's
+  // ground truth does), and evo associates them regardless (each pose of the shorter trajectory
+  // to the nearest stamp of the other, the first of equals). Said once, with a count.
+  Trajectory traj = io::readTrajectory(file, f, times_path, io::StampOrder::kAsGiven);
+  const io::StampOrderSummary order = io::summarizeStampOrder(traj.t_ns);
+  if (order.repeated + order.steps_back > 0) {
+    spdlog::warn(
+        "{}: {} repeated timestamps and {} steps back (the first at pose {}, t = {} s): "
+        "associated as evo does, each pose of the shorter trajectory with the nearest stamp of "
+        "the other (the first of equal stamps)",
+        file, order.repeated, order.steps_back, order.first_index + 1,
+        io::formatSeconds(traj.t_ns[order.first_index]));
+  }
+  return traj;
 }
 
 std::string alignmentName(eval::Alignment a) {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <utility>
 
 #include "odometry/error.hpp"
 
@@ -66,24 +67,49 @@ Stats computeStats(const std::vector<double>& errors) {
 
 namespace {
 
+// The first index of the smallest |b[j] - target| (numpy argmin) when b does not decrease: a
+// binary search, then the first of a run of equal stamps.
+std::pair<std::size_t, std::int64_t> nearestSorted(const std::vector<std::int64_t>& b,
+                                                   std::int64_t target) {
+  const auto it = std::lower_bound(b.begin(), b.end(), target);  // the first of equals
+  std::size_t best = 0;
+  std::int64_t best_diff = std::numeric_limits<std::int64_t>::max();
+  if (it != b.end()) {
+    best = static_cast<std::size_t>(it - b.begin());
+    best_diff = *it - target;
+  }
+  if (it != b.begin() && target - *(it - 1) <= best_diff) {  // ties go to the lower index
+    const auto first = std::lower_bound(b.begin(), it, *(it - 1));
+    best = static_cast<std::size_t>(first - b.begin());
+    best_diff = target - *(it - 1);
+  }
+  return {best, best_diff};
+}
+
+// The same by a full scan, for stamps in any order (evo reads files unsorted and checks nothing).
+std::pair<std::size_t, std::int64_t> nearestScan(const std::vector<std::int64_t>& b,
+                                                 std::int64_t target) {
+  std::size_t best = 0;
+  std::int64_t best_diff = std::numeric_limits<std::int64_t>::max();
+  for (std::size_t j = 0; j < b.size(); ++j) {
+    const std::int64_t diff = b[j] > target ? b[j] - target : target - b[j];
+    if (diff < best_diff) {
+      best = j;
+      best_diff = diff;
+    }
+  }
+  return {best, best_diff};
+}
+
 // evo sync.matching_time_indices: for each stamp of `a`, the index of the nearest stamp of
 // `b + offset` (numpy argmin: the first of equals), kept when |dt| <= max_diff.
 void matchNearest(const std::vector<std::int64_t>& a, const std::vector<std::int64_t>& b,
                   std::int64_t max_diff_ns, std::int64_t offset_b_ns, std::vector<std::size_t>& ia,
                   std::vector<std::size_t>& ib) {
+  const bool sorted = std::is_sorted(b.begin(), b.end());
   for (std::size_t i = 0; i < a.size(); ++i) {
     const std::int64_t target = a[i] - offset_b_ns;  // b[j] + offset ~ a[i]
-    const auto it = std::lower_bound(b.begin(), b.end(), target);
-    std::size_t best = 0;
-    std::int64_t best_diff = std::numeric_limits<std::int64_t>::max();
-    if (it != b.end()) {
-      best = static_cast<std::size_t>(it - b.begin());
-      best_diff = *it - target;
-    }
-    if (it != b.begin() && target - *(it - 1) <= best_diff) {  // ties go to the lower index
-      best = static_cast<std::size_t>(it - b.begin()) - 1;
-      best_diff = target - *(it - 1);
-    }
+    const auto [best, best_diff] = sorted ? nearestSorted(b, target) : nearestScan(b, target);
     if (best_diff <= max_diff_ns) {
       ia.push_back(i);
       ib.push_back(best);

@@ -54,8 +54,8 @@ void requireFields(const Fields& fields, std::size_t expected, bool at_least,
 // Association and interpolation need strictly increasing stamps; a repeat or a step back means a
 // broken file (concatenated runs, a wrong column), never something to sort silently.
 void requireIncreasing(const std::vector<std::int64_t>& stamps, std::int64_t t_ns,
-                       const LineReader& at) {
-  if (stamps.empty() || t_ns > stamps.back()) return;
+                       const LineReader& at, StampOrder order = StampOrder::kIncreasing) {
+  if (order == StampOrder::kAsGiven || stamps.empty() || t_ns > stamps.back()) return;
   at.fail(fmt::format("timestamp not increasing (previous {} s, this {} s)",
                       formatSeconds(stamps.back()), formatSeconds(t_ns)));
 }
@@ -118,12 +118,12 @@ Eigen::Isometry3d parseKittiPose(const Fields& fields, const LineReader& at) {
   return pose;
 }
 
-std::vector<std::int64_t> readKittiTimes(const fs::path& file) {
+std::vector<std::int64_t> readKittiTimes(const fs::path& file, StampOrder order) {
   std::vector<std::int64_t> stamps;
   forEachRecord(file, 0, [&](const Fields& fields, const LineReader& at) {
     requireFields(fields, 1, false, at);
     const std::int64_t t_ns = parseSecondsNs(fields[0], at, "timestamp");
-    requireIncreasing(stamps, t_ns, at);
+    requireIncreasing(stamps, t_ns, at, order);
     stamps.push_back(t_ns);
   });
   return stamps;
@@ -166,14 +166,14 @@ std::string toString(TrajectoryFormat format) {
   return "unknown";
 }
 
-Trajectory readTum(const fs::path& file) {
+Trajectory readTum(const fs::path& file, StampOrder order) {
   Trajectory traj;
   forEachRecord(file, 0, [&](const Fields& fields, const LineReader& at) {
     requireFields(fields, 8, false, at);
     const std::int64_t t_ns = parseSecondsNs(fields[0], at, "timestamp");
     const auto v = parseValues(fields, 1, kTumNames, at);
     const Eigen::Quaterniond q = unitQuaternion(v[6], v[3], v[4], v[5], at);  // w last
-    requireIncreasing(traj.t_ns, t_ns, at);
+    requireIncreasing(traj.t_ns, t_ns, at, order);
     traj.t_ns.push_back(t_ns);
     traj.poses.push_back(makePose({v[0], v[1], v[2]}, q));
   });
@@ -181,7 +181,8 @@ Trajectory readTum(const fs::path& file) {
   return traj;
 }
 
-Trajectory readKitti(const fs::path& file, const std::optional<fs::path>& times_file) {
+Trajectory readKitti(const fs::path& file, const std::optional<fs::path>& times_file,
+                     StampOrder order) {
   Trajectory traj;
   forEachRecord(file, 0, [&](const Fields& fields, const LineReader& at) {
     requireFields(fields, 12, false, at);
@@ -189,7 +190,7 @@ Trajectory readKitti(const fs::path& file, const std::optional<fs::path>& times_
   });
   requirePoses(traj, file);
   if (!times_file) return traj;
-  traj.t_ns = readKittiTimes(*times_file);
+  traj.t_ns = readKittiTimes(*times_file, order);
   if (traj.t_ns.size() != traj.poses.size()) {
     throw InputError(*times_file, 0,
                      fmt::format("{} timestamps for {} poses in {}", traj.t_ns.size(),
@@ -198,14 +199,14 @@ Trajectory readKitti(const fs::path& file, const std::optional<fs::path>& times_
   return traj;
 }
 
-Trajectory readEurocCsv(const fs::path& file) {
+Trajectory readEurocCsv(const fs::path& file, StampOrder order) {
   Trajectory traj;
   forEachRecord(file, ',', [&](const Fields& fields, const LineReader& at) {
     requireFields(fields, 8, true, at);
     const std::int64_t t_ns = parseStampNs(fields[0], at);
     const auto v = parseValues(fields, 1, kEurocNames, at);
     const Eigen::Quaterniond q = unitQuaternion(v[3], v[4], v[5], v[6], at);  // w first
-    requireIncreasing(traj.t_ns, t_ns, at);
+    requireIncreasing(traj.t_ns, t_ns, at, order);
     traj.t_ns.push_back(t_ns);
     traj.poses.push_back(makePose({v[0], v[1], v[2]}, q));
   });
@@ -214,13 +215,23 @@ Trajectory readEurocCsv(const fs::path& file) {
 }
 
 Trajectory readTrajectory(const fs::path& file, TrajectoryFormat format,
-                          const std::optional<fs::path>& times_file) {
-  if (format == TrajectoryFormat::kKitti) return readKitti(file, times_file);
+                          const std::optional<fs::path>& times_file, StampOrder order) {
+  if (format == TrajectoryFormat::kKitti) return readKitti(file, times_file, order);
   if (times_file) {
     throw InvalidInput(fmt::format("{}: a times file only applies to the kitti format, not {}",
                                    times_file->string(), toString(format)));
   }
-  return format == TrajectoryFormat::kTum ? readTum(file) : readEurocCsv(file);
+  return format == TrajectoryFormat::kTum ? readTum(file, order) : readEurocCsv(file, order);
+}
+
+StampOrderSummary summarizeStampOrder(const std::vector<std::int64_t>& t_ns) {
+  StampOrderSummary s;
+  for (std::size_t i = 1; i < t_ns.size(); ++i) {
+    if (t_ns[i] > t_ns[i - 1]) continue;
+    if (s.repeated + s.steps_back == 0) s.first_index = i;
+    ++(t_ns[i] == t_ns[i - 1] ? s.repeated : s.steps_back);
+  }
+  return s;
 }
 
 void writeTum(const fs::path& file, const Trajectory& traj) {

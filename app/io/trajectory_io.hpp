@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "odometry/trajectory.hpp"
 
@@ -25,15 +26,31 @@ std::string toString(TrajectoryFormat format);
 // Throws InputError naming file and line when none fits.
 TrajectoryFormat detectTrajectoryFormat(const std::filesystem::path& file);
 
-Trajectory readTum(const std::filesystem::path& file);
+// kIncreasing: a stamp that repeats or steps back is an error naming the line (estimation and
+// interpolation need a monotonic stream: simulate, export, datasets). kAsGiven: stamps in any
+// order, as evo reads them (it checks nothing; gvio eval associates them as evo does).
+enum class StampOrder { kIncreasing, kAsGiven };
+
+Trajectory readTum(const std::filesystem::path& file, StampOrder order = StampOrder::kIncreasing);
 // Without `times_file` the result has no timestamps. With it, the times file holds one seconds
 // value per pose (the KITTI odometry times.txt layout) and the counts must match.
 Trajectory readKitti(const std::filesystem::path& file,
-                     const std::optional<std::filesystem::path>& times_file = std::nullopt);
-Trajectory readEurocCsv(const std::filesystem::path& file);
+                     const std::optional<std::filesystem::path>& times_file = std::nullopt,
+                     StampOrder order = StampOrder::kIncreasing);
+Trajectory readEurocCsv(const std::filesystem::path& file,
+                        StampOrder order = StampOrder::kIncreasing);
 // Throws InvalidInput when a times file is given for a format other than KITTI.
 Trajectory readTrajectory(const std::filesystem::path& file, TrajectoryFormat format,
-                          const std::optional<std::filesystem::path>& times_file = std::nullopt);
+                          const std::optional<std::filesystem::path>& times_file = std::nullopt,
+                          StampOrder order = StampOrder::kIncreasing);
+
+// Stamps that are not strictly increasing: repeats (t == previous) and steps back (t < previous),
+// with the index of the first such pose.
+struct StampOrderSummary {
+  std::size_t repeated = 0, steps_back = 0;
+  std::size_t first_index = 0;  // meaningful when repeated + steps_back > 0
+};
+StampOrderSummary summarizeStampOrder(const std::vector<std::int64_t>& t_ns);
 
 // Writers replace `file` atomically. TUM, EuRoC and KITTI times need timestamps (InvalidInput if
 // the trajectory has none); KITTI poses ignore them.

@@ -37,6 +37,32 @@ class CliEval : public ::testing::Test {
   Trajectory ref_, est_;
 };
 
+// A repeated stamp (TUM RGB-D fr2/desk's ground truth has them) is associated as evo does: the
+// first pose with that stamp, with a warning; the strict readers elsewhere still refuse it.
+TEST_F(CliEval, RepeatedStampsAreAssociatedAsEvoDoes) {
+  const auto withRepeat = [&](bool perturbed_first) {
+    Trajectory t = ref_;
+    Eigen::Isometry3d moved = t.poses[20];
+    moved.translation().x() += 3.0;
+    const auto at = t.poses.begin() + (perturbed_first ? 20 : 21);
+    t.poses.insert(at, moved);
+    t.t_ns.insert(t.t_ns.begin() + 20, t.t_ns[20]);
+    return t;
+  };
+  io::writeTum(dir_.path() / "repeat_after.tum", withRepeat(false));
+  io::writeTum(dir_.path() / "repeat_first.tum", withRepeat(true));
+  const auto apeMax = [&](const std::string& est, const std::string& json) {
+    const auto r =
+        runGvio("eval --ref " + p("ref.tum") + " --est " + p(est) + " --json " + p(json));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_THAT(r.err, HasSubstr("1 repeated timestamps and 0 steps back (the first at pose 22"));
+    return nlohmann::json::parse(readText(p(json)))["ape"]["max"].get<double>();
+  };
+  // The longer estimate is matched from the reference's stamps: the first of the two poses.
+  EXPECT_NEAR(apeMax("repeat_after.tum", "a.json"), 0.0, 1e-9);
+  EXPECT_NEAR(apeMax("repeat_first.tum", "b.json"), 3.0, 1e-9);
+}
+
 TEST_F(CliEval, TableJsonAlignedAndPlots) {
   const auto r =
       runGvio("eval --ref " + p("ref.tum") + " --est " + p("est.tum") + " --rpe-delta 5 --json " +

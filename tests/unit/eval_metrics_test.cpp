@@ -1,6 +1,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <random>
 
 #include "eval/evaluate.hpp"
@@ -109,6 +111,48 @@ TEST(EvalAssociate, NearestWithinMaxDiffAndTies) {
   EXPECT_EQ(a.ref, (std::vector<std::size_t>{0, 2, 2}));  // 49->0, 151->200, 250->200 (lower)
   const auto b = associateByTime(ref, {0, 100, 200, 300, 400}, 0, 0);  // longer estimate
   EXPECT_EQ(b.ref, (std::vector<std::size_t>{0, 1, 2, 3}));
+}
+
+// evo's association, ported literally (sync.associate_trajectories + matching_time_indices):
+// the shorter trajectory (the second on equal lengths) against the longer, numpy argmin.
+Association evoAssociate(const std::vector<std::int64_t>& ref, const std::vector<std::int64_t>& est,
+                         std::int64_t max_diff) {
+  const bool est_longer = est.size() > ref.size();
+  const auto& shorter = est_longer ? ref : est;
+  const auto& longer = est_longer ? est : ref;
+  std::vector<std::size_t> is, il;
+  for (std::size_t i = 0; i < shorter.size(); ++i) {
+    std::size_t best = 0;
+    for (std::size_t j = 1; j < longer.size(); ++j) {
+      if (std::llabs(longer[j] - shorter[i]) < std::llabs(longer[best] - shorter[i])) best = j;
+    }
+    if (std::llabs(longer[best] - shorter[i]) <= max_diff) {
+      is.push_back(i);
+      il.push_back(best);
+    }
+  }
+  Association a;
+  a.ref = est_longer ? is : il;
+  a.est = est_longer ? il : is;
+  return a;
+}
+
+TEST(EvalAssociate, RepeatedAndUnsortedStampsAsEvoDoes) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> step(0, 3);  // 0: a repeated stamp
+  for (int trial = 0; trial < 40; ++trial) {
+    std::vector<std::int64_t> ref, est;
+    std::int64_t t = 0;
+    for (int i = 0; i < 60; ++i) ref.push_back(t += step(rng) * 4'000'000);
+    t = 2'000'000;
+    for (int i = 0; i < 55 + trial % 10; ++i) est.push_back(t += step(rng) * 5'000'000);
+    if (trial % 2 == 1) std::shuffle(est.begin(), est.end(), rng);  // steps back too
+    const Association a = associateByTime(ref, est, 3'000'000, 0);
+    const Association b = evoAssociate(ref, est, 3'000'000);
+    EXPECT_EQ(a.ref, b.ref) << "trial " << trial;
+    EXPECT_EQ(a.est, b.est) << "trial " << trial;
+    EXPECT_FALSE(a.ref.empty());
+  }
 }
 
 TEST(EvalStats, PopulationStdAndMedian) {

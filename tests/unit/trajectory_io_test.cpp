@@ -282,6 +282,31 @@ TEST_F(TrajectoryIoTest, RejectsDuplicateTimestamp) {
                     "timestamp not increasing (previous 0.000000006"));
 }
 
+// gvio eval reads stamps as evo does: in any order, with a summary of what is not increasing.
+TEST_F(TrajectoryIoTest, AsGivenKeepsRepeatsAndStepsBackInFileOrder) {
+  const fs::path tum = write("any.tum",
+                             "2 0 0 0 0 0 0 1\n2 1 0 0 0 0 0 1\n1 2 0 0 0 0 0 1\n"
+                             "3 3 0 0 0 0 0 1\n3 4 0 0 0 0 0 1\n");
+  const Trajectory t = readTum(tum, StampOrder::kAsGiven);
+  ASSERT_EQ(t.size(), 5U);
+  EXPECT_EQ(t.t_ns, (std::vector<std::int64_t>{2'000'000'000, 2'000'000'000, 1'000'000'000,
+                                               3'000'000'000, 3'000'000'000}));
+  EXPECT_DOUBLE_EQ(t.poses[2].translation().x(), 2.0);
+  const StampOrderSummary s = summarizeStampOrder(t.t_ns);
+  EXPECT_EQ(s.repeated, 2U);
+  EXPECT_EQ(s.steps_back, 1U);
+  EXPECT_EQ(s.first_index, 1U);
+  EXPECT_EQ(summarizeStampOrder({1, 2, 3}).repeated + summarizeStampOrder({1, 2, 3}).steps_back,
+            0U);
+  const fs::path csv = write("any.csv", "6,0,0,0,1,0,0,0\n6,0,0,0,1,0,0,0\n");
+  EXPECT_EQ(
+      readTrajectory(csv, TrajectoryFormat::kEuroc, std::nullopt, StampOrder::kAsGiven).size(), 2U);
+  const fs::path kitti = write("k.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1 0\n");
+  const fs::path times = write("times.txt", "0.5\n0.5\n");
+  EXPECT_EQ(readKitti(kitti, times, StampOrder::kAsGiven).t_ns.size(), 2U);
+  EXPECT_THROW(readKitti(kitti, times), InputError);  // the default stays strict
+}
+
 TEST_F(TrajectoryIoTest, RejectsUnnormalisedQuaternion) {
   const fs::path file = write("q.tum", "0 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1.01\n");
   EXPECT_TRUE(
