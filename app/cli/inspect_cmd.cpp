@@ -10,6 +10,7 @@
 #include "io/dataset_summary.hpp"
 #include "io/gnss_file.hpp"
 #include "io/image_loader.hpp"
+#include "io/kalibr.hpp"
 
 namespace gvio::cli {
 namespace {
@@ -19,6 +20,7 @@ struct InspectOptions {
   std::string format = "auto";
   std::optional<std::string> json;
   std::optional<std::string> gnss_file;
+  std::vector<std::string> calib;
   bool quick = false;
   ConfigOptions config;
 };
@@ -42,6 +44,9 @@ std::size_t checkImages(const io::Dataset& ds, bool quick, ProgressStyle style) 
 int runInspect(const InspectOptions& opt, const CommonOptions& common) {
   const AppConfig config = opt.config.load();
   io::Dataset ds = io::readDataset(opt.dataset, io::parseDatasetFormat(opt.format), config.dataset);
+  if (!opt.calib.empty()) {
+    io::applyKalibr(ds, io::readKalibr({opt.calib.begin(), opt.calib.end()}));
+  }
   if (opt.gnss_file) io::useGnssFile(ds, *opt.gnss_file, config.dataset);
   for (const auto& w : ds.warnings) spdlog::warn("{}", w);
   const std::size_t images = checkImages(ds, opt.quick, common.progressStyle());
@@ -68,6 +73,8 @@ Command addInspectCommand(CLI::App& app, const CommonOptions& common) {
   sub->add_option("--format", opt->format, "Dataset format")
       ->check(CLI::IsMember({"auto", "kitti-raw", "euroc", "nmea", "comma2k19"}));
   sub->add_option("--json", opt->json, "Also write the summary as JSON to this file");
+  sub->add_option("--calib", opt->calib,
+                  "Kalibr calibration replacing the dataset's (camchain.yaml and/or imu.yaml)");
   sub->add_option("--gnss-file", opt->gnss_file,
                   "GNSS fixes from this file instead of the dataset's: NMEA, RTKLIB .pos or CSV");
   sub->add_flag("--quick", opt->quick,

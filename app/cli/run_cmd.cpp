@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <memory>
 #include <thread>
+#include <vector>
 
 #include "cli/app.hpp"
 #include "run/pipeline.hpp"
@@ -24,6 +25,7 @@ struct RunOptions {
   std::string out = "out/run";
   std::optional<std::string> two_pass;
   std::optional<std::string> gnss_file;
+  std::vector<std::string> calib;
   int threads = defaultThreads();
   ConfigOptions config;
 };
@@ -41,6 +43,7 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
   request.seed = opt.seed;
   request.threads = opt.threads;
   if (opt.gnss_file) request.gnss_file = *opt.gnss_file;
+  request.calib_files.assign(opt.calib.begin(), opt.calib.end());
   request.out = opt.out;
   request.command_line = common.command_line;
   request.config_yaml = dumpConfigYaml(config);
@@ -76,6 +79,9 @@ Command addRunCommand(CLI::App& app, const CommonOptions& common) {
                   "Degrade the dataset's GNSS fixes: none, spp, rtk or a YAML noise-model file "
                   "(reproduces SPP-grade GNSS on an RTK-grade recording)")
       ->capture_default_str();
+  sub->add_option("--calib", opt->calib,
+                  "Kalibr calibration replacing the dataset's: camchain.yaml (pinhole radtan, "
+                  "T_cam_imu, timeshift_cam_imu) and/or imu.yaml (noise densities, random walks)");
   sub->add_option("--gnss-file", opt->gnss_file,
                   "GNSS fixes from this file instead of the dataset's (any format): NMEA 0183, an "
                   "RTKLIB solution (.pos: GPST/UTC, lat/lon/height or ECEF) or CSV "

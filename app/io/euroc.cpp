@@ -8,49 +8,13 @@
 #include <sstream>
 
 #include "io/input_error.hpp"
+#include "io/sensor_yaml.hpp"
 #include "io/text.hpp"
 #include "io/trajectory_io.hpp"
 
 namespace gvio::io {
 namespace fs = std::filesystem;
 namespace {
-
-// Kalibr writes "%YAML:1.0", which is not valid YAML 1.2: drop that directive before parsing.
-YAML::Node loadSensorYaml(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file, 0, "file not found");
-  std::stringstream text;
-  std::string line;
-  bool first = true;
-  while (std::getline(in, line)) {
-    if (first && line.rfind("%YAML", 0) == 0) line = "#" + line;
-    first = false;
-    text << line << '\n';
-  }
-  try {
-    YAML::Node root = YAML::Load(text.str());
-    if (!root.IsMap()) throw InputError(file, 0, "expected a YAML mapping of sensor parameters");
-    return root;
-  } catch (const YAML::Exception& e) {
-    throw InputError(file, static_cast<std::size_t>(e.mark.line + 1), e.msg);
-  }
-}
-
-template <typename T>
-std::vector<T> yamlList(const YAML::Node& root, const char* key, std::size_t count,
-                        const fs::path& file) {
-  const YAML::Node node = root[key];
-  if (!node || !node.IsSequence() || node.size() != count) {
-    throw InputError(file, node ? static_cast<std::size_t>(node.Mark().line + 1) : 0,
-                     fmt::format("'{}' must be a list of {} numbers", key, count));
-  }
-  try {
-    return node.as<std::vector<T>>();
-  } catch (const YAML::Exception&) {
-    throw InputError(file, static_cast<std::size_t>(node.Mark().line + 1),
-                     fmt::format("'{}' holds a non-numeric value", key));
-  }
-}
 
 Eigen::Isometry3d yamlTransform(const YAML::Node& root, const fs::path& file) {
   if (!root["T_BS"]) return Eigen::Isometry3d::Identity();

@@ -9,6 +9,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "io/dataset.hpp"
 #include "run/map_passes.hpp"
@@ -27,6 +28,7 @@ struct RunRequest {
   std::optional<sim::GnssErrorModel> gnss_noise;
   std::uint64_t seed = 1;                          // of the GNSS degradation
   std::optional<std::filesystem::path> gnss_file;  // --gnss-file: replaces the dataset's fixes
+  std::vector<std::filesystem::path> calib_files;  // --calib: Kalibr camchain / imu files
   std::filesystem::path out;
   std::optional<TwoPassSpans> two_pass;
   // --threads: 1 runs every stage in order on one thread; >= 2 overlaps them (decoding ahead of

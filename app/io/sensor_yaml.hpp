@@ -1,0 +1,39 @@
+#pragma once
+// YAML sensor files as Kalibr and the ASL/EuRoC tools write them, for the readers that take
+// calibration from them (io/euroc, io/kalibr). Errors are InputError with the file and line.
+#include <yaml-cpp/yaml.h>
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "io/input_error.hpp"
+
+namespace gvio::io {
+
+// The file parsed as one YAML mapping. Kalibr writes "%YAML:1.0", which is not valid YAML 1.2:
+// that directive is dropped before parsing.
+YAML::Node loadSensorYaml(const std::filesystem::path& file);
+
+// The line of `node` for error messages (0 when the node is absent).
+std::size_t lineOf(const YAML::Node& node);
+
+// root[key] as a list of exactly `count` values of type T.
+template <typename T>
+std::vector<T> yamlList(const YAML::Node& root, const char* key, std::size_t count,
+                        const std::filesystem::path& file) {
+  const YAML::Node node = root[key];
+  if (!node || !node.IsSequence() || node.size() != count) {
+    throw InputError(
+        file, lineOf(node),
+        "'" + std::string(key) + "' must be a list of " + std::to_string(count) + " numbers");
+  }
+  try {
+    return node.as<std::vector<T>>();
+  } catch (const YAML::Exception&) {
+    throw InputError(file, lineOf(node), "'" + std::string(key) + "' holds a non-numeric value");
+  }
+}
+
+}  // namespace gvio::io

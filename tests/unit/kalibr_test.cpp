@@ -1,0 +1,190 @@
+// Kalibr calibration files (issue 16): camchain.yaml and imu.yaml into the dataset's cameras, IMU
+// noise and camera clock; bad files named with their line; gvio run --calib on a simulated drive.
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "io/dataset.hpp"
+#include "io/input_error.hpp"
+#include "io/kalibr.hpp"
+#include "support/fixtures.hpp"
+
+namespace gvio::io {
+namespace {
+using testing::AllOf;
+using testing::HasSubstr;
+namespace fs = std::filesystem;
+
+std::string matrixYaml(const Eigen::Matrix4d& m, const std::string& indent) {
+  std::string out;
+  for (int r = 0; r < 4; ++r) {
+    out += fmt::format("{}- [{:.17g}, {:.17g}, {:.17g}, {:.17g}]\n", indent, m(r, 0), m(r, 1),
+                       m(r, 2), m(r, 3));
+  }
+  return out;
+}
+
+// A Kalibr camchain block for `cam` (T_b_c: camera in the IMU body frame).
+std::string cameraYaml(const std::string& name, const CameraModel& cam, double timeshift_s,
+                       std::string distortion = "", const std::string& extra = "") {
+  if (distortion.empty()) distortion = cam.distortion.empty() ? "none" : "radtan";
+  const std::vector<double> d =
+      cam.distortion.empty() ? std::vector<double>{0, 0, 0, 0} : cam.distortion;
+  return fmt::format(
+      "{}:\n  T_cam_imu:\n{}  camera_model: pinhole\n  distortion_coeffs: [{:.17g}, {:.17g}, "
+      "{:.17g}, {:.17g}]\n  distortion_model: {}\n  intrinsics: [{:.17g}, {:.17g}, {:.17g}, "
+      "{:.17g}]\n  resolution: [{}, {}]\n  rostopic: /{}/image_raw\n  timeshift_cam_imu: {}\n{}",
+      name, matrixYaml(cam.T_b_c.inverse().matrix(), "  "), d[0], d[1], d[2], d[3], distortion,
+      cam.fx, cam.fy, cam.cx, cam.cy, cam.width_px, cam.height_px, name, timeshift_s, extra);
+}
+
+CameraModel testCamera(const std::string& name, double x) {
+  CameraModel cam;
+  cam.name = name;
+  cam.width_px = 752;
+  cam.height_px = 480;
+  cam.fx = 458.654;
+  cam.fy = 457.296;
+  cam.cx = 367.215;
+  cam.cy = 248.375;
+  cam.distortion = {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05};
+  cam.T_b_c.linear() =
+      Eigen::AngleAxisd(0.02, Eigen::Vector3d(0.3, 1, 0.2).normalized()).toRotationMatrix();
+  cam.T_b_c.translation() = Eigen::Vector3d(x, 0.066, 0.01);
+  return cam;
+}
+
+constexpr const char* kImuYaml =
+    "%YAML:1.0\nimu0:\n  accelerometer_noise_density: 0.0028\n  accelerometer_random_walk: "
+    "0.00086\n  gyroscope_noise_density: 0.00016\n  gyroscope_random_walk: 2.2e-05\n  rostopic: "
+    "/imu0\n  update_rate: 200.0\n";
+
+TEST(Kalibr, CamchainAndImuFiles) {
+  test::TempDir dir("kalibr");
+  const CameraModel c0 = testCamera("cam0", -0.02), c1 = testCamera("cam1", 0.09);
+  const Eigen::Matrix4d T_c1_c0 = (c1.T_b_c.inverse() * c0.T_b_c).matrix();
+  test::writeText(
+      dir.path() / "camchain.yaml",
+      cameraYaml("cam0", c0, 0.0125) +
+          cameraYaml("cam1", c1, 0.0125, "radtan", "  T_cn_cnm1:\n" + matrixYaml(T_c1_c0, "  ")));
+  test::writeText(dir.path() / "imu.yaml", kImuYaml);
+  const KalibrCalibration k = readKalibr({dir.path() / "camchain.yaml", dir.path() / "imu.yaml"});
+  ASSERT_EQ(k.cameras.size(), 2U);
+  EXPECT_TRUE(k.warnings.empty()) << k.warnings.front();
+  EXPECT_EQ(k.cameras[1].name, "cam1");
+  EXPECT_DOUBLE_EQ(k.cameras[0].fx, 458.654);
+  EXPECT_EQ(k.cameras[0].width_px, 752);
+  EXPECT_EQ(k.cameras[0].distortion, c0.distortion);
+  EXPECT_TRUE(k.cameras[1].T_b_c.isApprox(c1.T_b_c, 1e-12));
+  EXPECT_DOUBLE_EQ(k.timeshift_cam_imu_s, 0.0125);
+  ASSERT_TRUE(k.imu_noise.has_value());
+  EXPECT_DOUBLE_EQ(k.imu_noise->acc_noise_density, 0.0028);
+  EXPECT_DOUBLE_EQ(k.imu_noise->gyr_random_walk, 2.2e-05);
+
+  // cam1 from T_cn_cnm1 alone; a disagreeing pair is used as T_cam_imu, with a warning.
+  std::string chained =
+      cameraYaml("cam0", c0, 0.0) + "cam1:\n  T_cn_cnm1:\n" + matrixYaml(T_c1_c0, "  ") +
+      cameraYaml("x", c1, 0.0).substr(cameraYaml("x", c1, 0.0).find("  camera_model"));
+  test::writeText(dir.path() / "chained.yaml", chained);
+  EXPECT_TRUE(readKalibr({dir.path() / "chained.yaml"}).cameras[1].T_b_c.isApprox(c1.T_b_c, 1e-9));
+  Eigen::Matrix4d off = T_c1_c0;
+  off(0, 3) += 0.01;
+  test::writeText(
+      dir.path() / "off.yaml",
+      cameraYaml("cam0", c0, 0.0) +
+          cameraYaml("cam1", c1, 0.0, "radtan", "  T_cn_cnm1:\n" + matrixYaml(off, "  ")));
+  const KalibrCalibration warned = readKalibr({dir.path() / "off.yaml"});
+  ASSERT_EQ(warned.warnings.size(), 1U);
+  EXPECT_THAT(warned.warnings[0], HasSubstr("disagree by 0.0100 m"));
+
+  // Into a dataset: cameras and noise replaced, frames moved into the IMU's clock.
+  Dataset ds;
+  ds.cameras.resize(2);
+  ds.frames.resize(2);
+  ds.frames[1].t_ns = 100'000'000;
+  applyKalibr(ds, k);
+  EXPECT_EQ(ds.cameras[0].fx, 458.654);
+  EXPECT_EQ(ds.frames[0].t_ns, 12'500'000);
+  EXPECT_EQ(ds.frames[1].t_ns, 112'500'000);
+  ASSERT_TRUE(ds.imu_noise.has_value());
+  ds.cameras.resize(1);
+  EXPECT_THROW(applyKalibr(ds, k), InvalidInput);  // two calibrated cameras, one in the dataset
+}
+
+std::string kalibrError(const std::string& text) {
+  test::TempDir dir("kalibr_bad");
+  const fs::path file = dir.path() / "camchain.yaml";
+  test::writeText(file, text);
+  try {
+    readKalibr({file});
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(Kalibr, BadFilesNameTheFileAndLine) {
+  const CameraModel c0 = testCamera("cam0", 0.0);
+  EXPECT_THAT(kalibrError(cameraYaml("cam0", c0, 0.0, "equidistant")),
+              AllOf(HasSubstr("camchain.yaml:9"), HasSubstr("'equidistant' is not supported yet")));
+  EXPECT_THAT(kalibrError(cameraYaml("cam0", c0, 0.0, "banana")), HasSubstr("unknown distortion"));
+  std::string no_t = cameraYaml("cam0", c0, 0.0);
+  no_t.erase(no_t.find("  T_cam_imu"), no_t.find("  camera_model") - no_t.find("  T_cam_imu"));
+  EXPECT_THAT(kalibrError(no_t), HasSubstr("missing 'T_cam_imu'"));
+  std::string no_k = cameraYaml("cam0", c0, 0.0);
+  no_k.replace(no_k.find("intrinsics"), 10, "intrinsix");
+  EXPECT_THAT(kalibrError(no_k), HasSubstr("'intrinsics' must be a list of 4 numbers"));
+  std::string sheared = cameraYaml("cam0", c0, 0.0);
+  sheared.replace(sheared.find("- ["), 3, "- [2.0, 0, 0, 0]\n  #");
+  EXPECT_THAT(kalibrError(sheared), AllOf(HasSubstr("camchain.yaml:3"), HasSubstr("not a rigid")));
+  EXPECT_THAT(kalibrError("foo: 1\n"), HasSubstr("neither a Kalibr camera chain"));
+  EXPECT_THAT(kalibrError("imu0:\n  accelerometer_noise_density: -1\n  accelerometer_random_walk: "
+                          "1\n  gyroscope_noise_density: 1\n  gyroscope_random_walk: 1\n"),
+              HasSubstr("camchain.yaml:2"));
+  EXPECT_THAT(kalibrError("cam0: [unclosed\n"), HasSubstr("camchain.yaml:"));
+}
+
+// gvio run --calib with the simulated drive's own calibration written as Kalibr files gives the
+// same run as the dataset's calibration files; a fisheye chain exits 2 with one line.
+TEST(CliKalibr, TheDrivesOwnCalibrationAsKalibrFilesGivesTheSameRun) {
+  const fs::path drive = test::cachedSimulation(
+      fmt::format("--trajectory {}/assets/demo/drive.tum --seconds 20 --seed 9", GVIO_SOURCE_DIR));
+  const Dataset ds = readDataset(drive, std::nullopt, ReaderConfig{});
+  ASSERT_EQ(ds.cameras.size(), 2U);
+  test::TempDir dir("cli_kalibr");
+  test::writeText(dir.path() / "camchain.yaml",
+                  cameraYaml("cam0", ds.cameras[0], 0.0) + cameraYaml("cam1", ds.cameras[1], 0.0));
+  const auto run = [&](const std::string& extra, const std::string& out) {
+    return test::runGvio(fmt::format(
+        "run --dataset {} --out {} --no-progress --gnss off --set map.enabled=false --set "
+        "loops.enabled=false {}",
+        test::quoted(drive), test::quoted(dir.path() / out), extra));
+  };
+  const test::CommandResult own = run("", "own");
+  ASSERT_EQ(own.exit_code, 0) << own.err;
+  const test::CommandResult kalibr =
+      run("--calib " + test::quoted(dir.path() / "camchain.yaml"), "kalibr");
+  ASSERT_EQ(kalibr.exit_code, 0) << kalibr.err;
+  const auto ape = [&](const std::string& out) {
+    const auto j = nlohmann::json::parse(test::readText(dir.path() / out / "report.json"));
+    return j["evaluation"]["ape_se3"]["rmse"].get<double>();
+  };
+  EXPECT_NEAR(ape("kalibr"), ape("own"), 1e-3);
+  EXPECT_LT(ape("kalibr"), 0.5);
+
+  test::writeText(dir.path() / "fisheye.yaml",
+                  cameraYaml("cam0", ds.cameras[0], 0.0, "equidistant") +
+                      cameraYaml("cam1", ds.cameras[1], 0.0, "equidistant"));
+  const test::CommandResult bad =
+      run("--calib " + test::quoted(dir.path() / "fisheye.yaml"), "bad");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_THAT(bad.err, HasSubstr("fisheye.yaml:"));
+  EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+}
+
+}  // namespace
+}  // namespace gvio::io
