@@ -75,9 +75,8 @@ mapping::PoseLookup mapPoses(const MapRecorder& recorder, const Trajectory* fuse
 // An empty cloud writes no cloud files and warns.
 // `georeferenced`: `fused` is in local ENU (else the VIO world, e.g. loop-closed without GNSS).
 // `alongside`: read-only looks at the keyframes (revisits, --two-pass) that need their dense
-// points; it runs first. `threaded`: `alongside` and then the occupancy run on a thread of their
-// own (nothing freed until it is done: more memory held, less time), while the clouds are built
-// and written on the calling thread; the files are the same either way.
+// points; it runs first. `threaded`: the occupancy is built on a thread of its own while the
+// cloud files are written (nothing freed until it is done); the files are the same either way.
 MapRunResult buildAndWriteMap(MapRecorder& recorder, const Trajectory* fused, bool georeferenced,
                               const std::filesystem::path& out, bool threaded = false,
                               const std::function<void()>& alongside = {});
