@@ -35,21 +35,9 @@ CameraModel readCameraYaml(const fs::path& file, const std::string& name) {
         fmt::format("unsupported camera model '{}' / '{}' (pinhole radial-tangential only)", model,
                     dist));
   }
-  CameraModel cam;
-  cam.name = name;
-  const auto res = yamlList<int>(y, "resolution", 2, file);
-  const auto k = yamlList<double>(y, "intrinsics", 4, file);
-  cam.width_px = res[0];
-  cam.height_px = res[1];
-  cam.fx = k[0];
-  cam.fy = k[1];
-  cam.cx = k[2];
-  cam.cy = k[3];
+  CameraModel cam = pinholeCamera(y, name, file);
   cam.distortion = yamlList<double>(y, "distortion_coefficients", 4, file);
   cam.T_b_c = yamlTransform(y, file);
-  if (cam.width_px <= 0 || cam.height_px <= 0 || cam.fx <= 0.0 || cam.fy <= 0.0) {
-    throw InputError(file, 0, "resolution and focal lengths must be positive");
-  }
   return cam;
 }
 

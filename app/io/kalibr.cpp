@@ -76,19 +76,7 @@ Eigen::Isometry3d readCamera(const YAML::Node& block, const std::string& name,
     throw InputError(file, lineOf(block["distortion_model"]),
                      fmt::format("{}: unknown distortion_model '{}'", name, distortion));
   }
-  CameraModel cam;
-  cam.name = name;
-  const auto k = yamlList<double>(block, "intrinsics", 4, file);
-  const auto res = yamlList<int>(block, "resolution", 2, file);
-  cam.fx = k[0];
-  cam.fy = k[1];
-  cam.cx = k[2];
-  cam.cy = k[3];
-  cam.width_px = res[0];
-  cam.height_px = res[1];
-  if (cam.width_px <= 0 || cam.height_px <= 0 || !(cam.fx > 0.0) || !(cam.fy > 0.0)) {
-    throw InputError(file, lineOf(block), name + ": resolution and focal lengths must be positive");
-  }
+  CameraModel cam = pinholeCamera(block, name, file);
   if (distortion == "radtan")
     cam.distortion = yamlList<double>(block, "distortion_coeffs", 4, file);
   Eigen::Isometry3d T_cam_imu;

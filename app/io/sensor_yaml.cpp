@@ -29,4 +29,22 @@ std::size_t lineOf(const YAML::Node& node) {
   return node ? static_cast<std::size_t>(node.Mark().line + 1) : 0;
 }
 
+CameraModel pinholeCamera(const YAML::Node& block, const std::string& name,
+                          const std::filesystem::path& file) {
+  CameraModel cam;
+  cam.name = name;
+  const auto res = yamlList<int>(block, "resolution", 2, file);
+  const auto k = yamlList<double>(block, "intrinsics", 4, file);
+  cam.width_px = res[0];
+  cam.height_px = res[1];
+  cam.fx = k[0];
+  cam.fy = k[1];
+  cam.cx = k[2];
+  cam.cy = k[3];
+  if (cam.width_px <= 0 || cam.height_px <= 0 || !(cam.fx > 0.0) || !(cam.fy > 0.0)) {
+    throw InputError(file, lineOf(block), name + ": resolution and focal lengths must be positive");
+  }
+  return cam;
+}
+
 }  // namespace gvio::io

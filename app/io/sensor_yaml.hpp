@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "io/input_error.hpp"
+#include "odometry/measurements.hpp"
 
 namespace gvio::io {
 
@@ -35,5 +36,11 @@ std::vector<T> yamlList(const YAML::Node& root, const char* key, std::size_t cou
     throw InputError(file, lineOf(node), "'" + std::string(key) + "' holds a non-numeric value");
   }
 }
+
+// The pinhole part of a camera block, as Kalibr's camchain and the ASL sensor.yaml both write it:
+// resolution [w h] and intrinsics [fu fv pu pv], all positive (else InputError at the block's
+// line, naming the camera). Distortion and extrinsics are left to the caller.
+CameraModel pinholeCamera(const YAML::Node& block, const std::string& name,
+                          const std::filesystem::path& file);
 
 }  // namespace gvio::io
