@@ -11,6 +11,7 @@
 #include "io/dataset.hpp"
 #include "io/input_error.hpp"
 #include "io/kalibr.hpp"
+#include "support/euroc_camera.hpp"
 #include "support/fixtures.hpp"
 
 namespace gvio::io {
@@ -42,22 +43,6 @@ std::string cameraYaml(const std::string& name, const CameraModel& cam, double t
       cam.fx, cam.fy, cam.cx, cam.cy, cam.width_px, cam.height_px, name, timeshift_s, extra);
 }
 
-CameraModel testCamera(const std::string& name, double x) {
-  CameraModel cam;
-  cam.name = name;
-  cam.width_px = 752;
-  cam.height_px = 480;
-  cam.fx = 458.654;
-  cam.fy = 457.296;
-  cam.cx = 367.215;
-  cam.cy = 248.375;
-  cam.distortion = {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05};
-  cam.T_b_c.linear() =
-      Eigen::AngleAxisd(0.02, Eigen::Vector3d(0.3, 1, 0.2).normalized()).toRotationMatrix();
-  cam.T_b_c.translation() = Eigen::Vector3d(x, 0.066, 0.01);
-  return cam;
-}
-
 constexpr const char* kImuYaml =
     "%YAML:1.0\nimu0:\n  accelerometer_noise_density: 0.0028\n  accelerometer_random_walk: "
     "0.00086\n  gyroscope_noise_density: 0.00016\n  gyroscope_random_walk: 2.2e-05\n  rostopic: "
@@ -65,7 +50,7 @@ constexpr const char* kImuYaml =
 
 TEST(Kalibr, CamchainAndImuFiles) {
   test::TempDir dir("kalibr");
-  const CameraModel c0 = testCamera("cam0", -0.02), c1 = testCamera("cam1", 0.09);
+  const CameraModel c0 = test::eurocCam0(), c1 = test::eurocCam1();
   const Eigen::Matrix4d T_c1_c0 = (c1.T_b_c.inverse() * c0.T_b_c).matrix();
   test::writeText(
       dir.path() / "camchain.yaml",
@@ -128,7 +113,7 @@ std::string kalibrError(const std::string& text) {
 }
 
 TEST(Kalibr, BadFilesNameTheFileAndLine) {
-  const CameraModel c0 = testCamera("cam0", 0.0);
+  const CameraModel c0 = test::eurocCam0();
   EXPECT_THAT(kalibrError(cameraYaml("cam0", c0, 0.0, "equidistant")),
               AllOf(HasSubstr("camchain.yaml:9"), HasSubstr("'equidistant' is not supported yet")));
   EXPECT_THAT(kalibrError(cameraYaml("cam0", c0, 0.0, "banana")), HasSubstr("unknown distortion"));
@@ -141,6 +126,12 @@ TEST(Kalibr, BadFilesNameTheFileAndLine) {
   std::string sheared = cameraYaml("cam0", c0, 0.0);
   sheared.replace(sheared.find("- ["), 3, "- [2.0, 0, 0, 0]\n  #");
   EXPECT_THAT(kalibrError(sheared), AllOf(HasSubstr("camchain.yaml:3"), HasSubstr("not a rigid")));
+  std::string flat = cameraYaml("cam0", c0, 0.0);
+  const std::size_t fu = flat.find("intrinsics: [") + 13;
+  flat.replace(fu, flat.find(',', fu) - fu, "0");  // a focal length of 0
+  EXPECT_THAT(kalibrError(flat),
+              AllOf(HasSubstr("camchain.yaml:2"),
+                    HasSubstr("cam0: resolution and focal lengths must be positive")));
   EXPECT_THAT(kalibrError("foo: 1\n"), HasSubstr("neither a Kalibr camera chain"));
   EXPECT_THAT(kalibrError("imu0:\n  accelerometer_noise_density: -1\n  accelerometer_random_walk: "
                           "1\n  gyroscope_noise_density: 1\n  gyroscope_random_walk: 1\n"),
