@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "run/stats.hpp"
+
 namespace gvio::run {
 
 odometry::FrameResult FrameStepper::step(std::int64_t t_ns, const odometry::RectifiedImages& images,
@@ -26,7 +28,7 @@ odometry::FrameResult FrameStepper::step(std::int64_t t_ns, const odometry::Rect
   } else {
     const auto start = Clock::now();
     tracked = estimator_.trackFrame(t_ns, images.left, images.right);
-    ms_tracking = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    ms_tracking = msSince(start);
   }
   // wouldAccept(next) depends on this frame's stamp only, which beginFrame has recorded; the
   // tracking ahead touches the front end alone, which processFrame leaves to it.

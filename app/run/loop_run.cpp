@@ -21,10 +21,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
 // The 1-sigma position uncertainty of a pose: the square root of its position covariance's
 // largest eigenvalue (the radius that covers every direction).
 double positionSigma(const fusion::PoseCovariance& cov) {

@@ -118,11 +118,6 @@ nlohmann::json writeCloudFiles(const std::filesystem::path& out, MapRunResult& r
   return writeLasOrSayWhy(out, r.frame, &blob);
 }
 
-double msSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
-
 }  // namespace
 
 MapRunResult buildAndWriteMap(MapRecorder& recorder, const Trajectory* fused, bool georeferenced,

@@ -20,6 +20,11 @@ TimingSummary summarizeTimings(std::vector<double> samples_ms) {
   return s;
 }
 
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
 double peakRssMb() {
   rusage usage{};
   if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;

@@ -16,16 +16,13 @@
 #include "odometry/rectifier.hpp"
 #include "run/frame_stepper.hpp"
 #include "run/ordered_work.hpp"
+#include "run/stats.hpp"
 
 namespace gvio::run {
 namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using odometry::VioMode;
-
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // A real recording may list images that are missing or damaged: each skips its frame. The first
 // one per folder is a warning, the rest are counted, so a long gap does not flood the log.
