@@ -46,3 +46,27 @@ if(GVIO_BUILD_TESTS)
   find_package(GTest REQUIRED)
   find_package(benchmark REQUIRED)
 endif()
+
+# ROS1 bags without ROS: Debian's librosbag-storage-dev with the sensor_msgs message headers. Its
+# pkg-config file requires a pluginlib.pc that Debian does not ship, so the pieces are found one by
+# one; pluginlib (ROS 2's, which bag.h includes for encryption plugins) keeps its headers one
+# folder down.
+pkg_check_modules(ROSCPP_SERIALIZATION REQUIRED IMPORTED_TARGET roscpp_serialization rostime
+                  cpp_common roslz4)
+find_library(ROSBAG_STORAGE_LIBRARY rosbag_storage REQUIRED)
+find_library(CONSOLE_BRIDGE_LIBRARY console_bridge REQUIRED)
+find_path(PLUGINLIB_INCLUDE_DIR pluginlib/class_loader.hpp PATH_SUFFIXES pluginlib REQUIRED)
+find_path(CLASS_LOADER_INCLUDE_DIR class_loader/class_loader.hpp PATH_SUFFIXES class_loader
+          REQUIRED)
+find_path(RCUTILS_INCLUDE_DIR rcutils/types.h PATH_SUFFIXES rcutils REQUIRED)
+find_path(RCPPUTILS_INCLUDE_DIR rcpputils/filesystem_helper.hpp PATH_SUFFIXES rcpputils REQUIRED)
+find_path(AMENT_INDEX_INCLUDE_DIR ament_index_cpp/get_resource.hpp PATH_SUFFIXES ament_index_cpp
+          REQUIRED)
+find_path(SENSOR_MSGS_INCLUDE_DIR sensor_msgs/Image.h REQUIRED)
+find_package(Boost REQUIRED COMPONENTS filesystem)
+add_library(gvio_rosbag_deps INTERFACE)
+target_include_directories(gvio_rosbag_deps SYSTEM INTERFACE
+  ${PLUGINLIB_INCLUDE_DIR} ${CLASS_LOADER_INCLUDE_DIR} ${RCUTILS_INCLUDE_DIR}
+  ${RCPPUTILS_INCLUDE_DIR} ${AMENT_INDEX_INCLUDE_DIR} ${SENSOR_MSGS_INCLUDE_DIR})
+target_link_libraries(gvio_rosbag_deps INTERFACE ${ROSBAG_STORAGE_LIBRARY} ${CONSOLE_BRIDGE_LIBRARY}
+                                                 PkgConfig::ROSCPP_SERIALIZATION Boost::filesystem)

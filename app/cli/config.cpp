@@ -173,6 +173,11 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("dataset.nmea_vertical_factor", c.dataset.nmea_vertical_factor),
       number("dataset.comma2k19_sigma_h_m", c.dataset.comma2k19_sigma_h_m),
       number("dataset.comma2k19_sigma_v_m", c.dataset.comma2k19_sigma_v_m),
+      text("dataset.topics.cam0", c.dataset.topic_cam0),
+      text("dataset.topics.cam1", c.dataset.topic_cam1),
+      text("dataset.topics.imu", c.dataset.topic_imu),
+      text("dataset.topics.gnss", c.dataset.topic_gnss),
+      number("dataset.stereo_sync_tolerance_s", c.dataset.stereo_sync_tolerance_s),
       boolean("imu.prefer_dataset_noise", c.imu.prefer_dataset_noise),
       number("imu.acc_noise_density", c.imu.noise.acc_noise_density),
       number("imu.gyr_noise_density", c.imu.noise.gyr_noise_density),
@@ -352,7 +357,13 @@ std::string dumpConfigYaml(const AppConfig& config) {
       section = head;
     }
     // Values go through the YAML parser so lists stay lists and numbers stay unquoted.
-    out << YAML::Key << key.name.substr(dot + 1) << YAML::Value << YAML::Load(key.get());
+    const std::string value = key.get();
+    out << YAML::Key << key.name.substr(dot + 1) << YAML::Value;
+    if (value.empty()) {
+      out << YAML::DoubleQuoted << "";  // an empty text value (a topic left to auto), not null
+    } else {
+      out << YAML::Load(value);
+    }
   }
   if (!section.empty()) out << YAML::EndMap;
   out << YAML::EndMap;

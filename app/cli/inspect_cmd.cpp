@@ -7,10 +7,8 @@
 
 #include "cli/app.hpp"
 #include "io/atomic_write.hpp"
+#include "io/dataset_sources.hpp"
 #include "io/dataset_summary.hpp"
-#include "io/gnss_file.hpp"
-#include "io/image_loader.hpp"
-#include "io/kalibr.hpp"
 
 namespace gvio::cli {
 namespace {
@@ -32,7 +30,7 @@ std::size_t checkImages(const io::Dataset& ds, bool quick, ProgressStyle style) 
   std::size_t images = 0;
   for (std::size_t i = 0; i < frames; ++i) {
     for (std::size_t c = 0; c < ds.cameras.size(); ++c) {
-      io::loadGrayImage(ds.frames[i].image_paths[c], ds.cameras[c]);
+      (void)io::loadFrameImage(ds, i, c);
       ++images;
     }
     progress.update(i + 1);
@@ -43,11 +41,13 @@ std::size_t checkImages(const io::Dataset& ds, bool quick, ProgressStyle style) 
 
 int runInspect(const InspectOptions& opt, const CommonOptions& common) {
   const AppConfig config = opt.config.load();
-  io::Dataset ds = io::readDataset(opt.dataset, io::parseDatasetFormat(opt.format), config.dataset);
-  if (!opt.calib.empty()) {
-    io::applyKalibr(ds, io::readKalibr({opt.calib.begin(), opt.calib.end()}));
-  }
-  if (opt.gnss_file) io::useGnssFile(ds, *opt.gnss_file, config.dataset);
+  io::DatasetSources sources{opt.dataset,
+                             io::parseDatasetFormat(opt.format),
+                             {opt.calib.begin(), opt.calib.end()},
+                             std::nullopt};
+  if (opt.gnss_file) sources.gnss_file = *opt.gnss_file;
+  sources.require_calibration = false;  // a summary needs no intrinsics
+  io::Dataset ds = io::openDataset(sources, config.dataset);
   for (const auto& w : ds.warnings) spdlog::warn("{}", w);
   const std::size_t images = checkImages(ds, opt.quick, common.progressStyle());
   const bool dataset_noise = ds.imu_noise && config.imu.prefer_dataset_noise;
@@ -68,10 +68,10 @@ Command addInspectCommand(CLI::App& app, const CommonOptions& common) {
   auto opt = std::make_shared<InspectOptions>();
   CLI::App* sub = app.add_subcommand("inspect", "Validate a dataset and summarise its sensors");
   sub->add_option("--dataset", opt->dataset,
-                  "Dataset folder (KITTI raw drive, EuRoC, comma2k19) or NMEA log")
+                  "Dataset folder (KITTI raw drive, EuRoC, comma2k19), ROS1 bag or NMEA log")
       ->required();
   sub->add_option("--format", opt->format, "Dataset format")
-      ->check(CLI::IsMember({"auto", "kitti-raw", "euroc", "nmea", "comma2k19"}));
+      ->check(CLI::IsMember({"auto", "kitti-raw", "euroc", "nmea", "comma2k19", "rosbag"}));
   sub->add_option("--json", opt->json, "Also write the summary as JSON to this file");
   sub->add_option("--calib", opt->calib,
                   "Kalibr calibration replacing the dataset's (camchain.yaml and/or imu.yaml)");

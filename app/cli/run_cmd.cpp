@@ -66,10 +66,10 @@ Command addRunCommand(CLI::App& app, const CommonOptions& common) {
       app.add_subcommand("run", "Visual-inertial odometry over a dataset, written as a run folder");
   sub->add_option("--dataset", opt->dataset,
                   "Dataset folder (KITTI raw drive, EuRoC; comma2k19 CSV: IMU + GNSS without a "
-                  "camera runs GNSS/INS)")
+                  "camera runs GNSS/INS) or ROS1 bag (.bag, with --calib)")
       ->required();
   sub->add_option("--format", opt->format, "Dataset format")
-      ->check(CLI::IsMember({"auto", "kitti-raw", "euroc", "comma2k19"}))
+      ->check(CLI::IsMember({"auto", "kitti-raw", "euroc", "comma2k19", "rosbag"}))
       ->capture_default_str();
   sub->add_option("--gnss", opt->gnss,
                   "GNSS fusion: auto (graph when the dataset has fixes), off, kf (the reference "

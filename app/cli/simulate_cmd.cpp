@@ -111,8 +111,10 @@ Command addSimulateCommand(CLI::App& app, const CommonOptions& common) {
                   "file (default): the file's body orientation, warned about when its x axis is "
                   "not the direction of travel; motion: a vehicle's, heading from the direction of "
                   "travel, pitch from the climb, roll zero");
-  sub->add_option("--format", o->format, "Output layout")
-      ->check(CLI::IsMember({"kitti-raw", "euroc"}));
+  sub->add_option("--format", o->format,
+                  "Output layout: kitti-raw, euroc, or rosbag (drive.bag + Kalibr camchain.yaml "
+                  "and imu.yaml)")
+      ->check(CLI::IsMember({"kitti-raw", "euroc", "rosbag"}));
   sub->add_option("--seconds", o->request.seconds, "Simulate only the first S seconds");
   sub->add_option("--camera", o->camera, "stereo or mono")
       ->check(CLI::IsMember({"stereo", "mono"}));

@@ -4,9 +4,11 @@
 
 #include "io/comma2k19.hpp"
 #include "io/euroc.hpp"
+#include "io/image_loader.hpp"
 #include "io/input_error.hpp"
 #include "io/kitti_raw.hpp"
 #include "io/nmea.hpp"
+#include "io/rosbag_dataset.hpp"
 
 namespace gvio::io {
 namespace fs = std::filesystem;
@@ -46,6 +48,8 @@ std::string toString(DatasetFormat format) {
       return "nmea";
     case DatasetFormat::kComma2k19:
       return "comma2k19";
+    case DatasetFormat::kRosbag:
+      return "rosbag";
   }
   return "unknown";
 }
@@ -56,16 +60,20 @@ std::optional<DatasetFormat> parseDatasetFormat(const std::string& name) {
   if (name == "euroc") return DatasetFormat::kEuroc;
   if (name == "nmea") return DatasetFormat::kNmea;
   if (name == "comma2k19") return DatasetFormat::kComma2k19;
+  if (name == "rosbag") return DatasetFormat::kRosbag;
   throw InvalidInput("unknown dataset format '" + name +
-                     "' (expected auto, kitti-raw, euroc, nmea or comma2k19)");
+                     "' (expected auto, kitti-raw, euroc, nmea, comma2k19 or rosbag)");
 }
 
 DatasetFormat detectFormat(const fs::path& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw InputError(path, 0, "dataset not found");
   if (fs::is_regular_file(path, ec)) {
+    if (path.extension() == ".bag" || looksLikeRosbag(path)) return DatasetFormat::kRosbag;
     if (looksLikeNmeaFile(path)) return DatasetFormat::kNmea;
-    throw InputError(path, 0, "a file that is not an NMEA 0183 log (expected a dataset folder)");
+    throw InputError(path, 0,
+                     "a file that is neither a ROS bag nor an NMEA 0183 log (expected a dataset "
+                     "folder)");
   }
   if (looksLikeKittiRaw(path)) return DatasetFormat::kKittiRaw;
   if (!findEurocMav0(path).empty()) return DatasetFormat::kEuroc;
@@ -94,11 +102,24 @@ Dataset readDataset(const fs::path& path, std::optional<DatasetFormat> format,
     case DatasetFormat::kComma2k19:
       ds = readComma2k19(path, config);
       break;
+    case DatasetFormat::kRosbag:
+      ds = readRosbag(path, config);
+      break;
   }
   if (ds.frames.empty() && ds.imu.empty() && ds.gnss.empty()) {
     throw InputError(path, 0, "dataset holds no camera frames, IMU samples or GNSS fixes");
   }
   return ds;
+}
+
+cv::Mat loadFrameImage(const Dataset& ds, std::size_t frame, std::size_t camera) {
+  if (ds.image_store) return ds.image_store->load(frame, camera, ds.cameras.at(camera));
+  return loadGrayImage(ds.frames.at(frame).image_paths.at(camera), ds.cameras.at(camera));
+}
+
+std::string imageSource(const Dataset& ds, std::size_t frame, std::size_t camera) {
+  if (ds.image_store) return ds.image_store->source(camera);
+  return ds.frames.at(frame).image_paths.at(camera).parent_path().string();
 }
 
 }  // namespace gvio::io

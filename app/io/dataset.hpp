@@ -3,9 +3,12 @@
 // whose images stay on disk until asked for (memory does not grow with sequence length).
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <opencv2/core/mat.hpp>
 
 #include "fusion/geodesy.hpp"
 #include "io/reader_config.hpp"
@@ -14,13 +17,38 @@
 
 namespace gvio::io {
 
-enum class DatasetFormat { kKittiRaw, kEuroc, kNmea, kComma2k19 };
+enum class DatasetFormat { kKittiRaw, kEuroc, kNmea, kComma2k19, kRosbag };
 std::string toString(DatasetFormat format);
 
-// One camera trigger: the timestamp and one image path per camera (same order as cameras).
+// One camera trigger: the timestamp and one image path per camera (same order as cameras); no
+// paths when the images live in a container (a bag) and the dataset's image store reads them.
 struct FrameRecord {
   std::int64_t t_ns = 0;
   std::vector<std::filesystem::path> image_paths;
+};
+
+// Images inside a container file (a ROS bag) rather than one file each.
+class ImageStore {
+ public:
+  virtual ~ImageStore() = default;
+  // Frame `frame`'s image of camera `camera`, 8-bit grey, checked against the camera's size.
+  // Throws InputError naming the container and the message. Safe to call from several threads.
+  [[nodiscard]] virtual cv::Mat load(std::size_t frame, std::size_t camera,
+                                     const CameraModel& model) const = 0;
+  // Where a camera's images come from (e.g. "drive.bag:/cam0/image_raw"), to group messages.
+  [[nodiscard]] virtual std::string source(std::size_t camera) const = 0;
+};
+
+// One topic of a ROS bag: what was read from it and what had to be repaired.
+struct BagTopicUse {
+  std::string role;  // cam0, cam1, imu, gnss
+  std::string topic;
+  std::string type;
+  std::size_t messages = 0;          // in the bag
+  std::size_t used = 0;              // kept (frames: paired; GNSS: with a fix)
+  std::size_t out_of_order = 0;      // header stamp older than an earlier message's: sorted
+  std::size_t duplicate_stamps = 0;  // a header stamp seen before: dropped
+  std::size_t zero_stamps = 0;       // header stamp 0: the bag's receive time stood in
 };
 
 struct Dataset {
@@ -39,7 +67,15 @@ struct Dataset {
   // a run in the same frame can be evaluated without alignment.
   std::optional<fusion::Lla> groundtruth_enu_origin;
   std::vector<std::string> warnings;  // non-fatal defects found while reading (also logged)
+  std::shared_ptr<const ImageStore> image_store;  // set when frames carry no image paths
+  std::vector<BagTopicUse> bag_topics;            // ROS bags only
 };
+
+// Frame `frame`'s image of camera `camera` (from its file or the image store), 8-bit grey and
+// size-checked. Throws InputError.
+cv::Mat loadFrameImage(const Dataset& dataset, std::size_t frame, std::size_t camera);
+// The file's folder or the store's source: what a run groups unreadable images by.
+std::string imageSource(const Dataset& dataset, std::size_t frame, std::size_t camera);
 
 // Reads a dataset folder (or an NMEA file) after validating every line of every text file.
 // `format` nullopt = detect. Throws InputError naming file and line on bad input.
@@ -49,7 +85,7 @@ Dataset readDataset(const std::filesystem::path& path, std::optional<DatasetForm
 // Format detection from the folder layout; throws InputError when nothing matches.
 DatasetFormat detectFormat(const std::filesystem::path& path);
 
-// Parses "auto" (nullopt), "kitti-raw", "euroc", "nmea", "comma2k19"; throws InvalidInput
+// Parses "auto" (nullopt), "kitti-raw", "euroc", "nmea", "comma2k19", "rosbag"; throws InvalidInput
 // otherwise.
 std::optional<DatasetFormat> parseDatasetFormat(const std::string& name);
 

@@ -162,8 +162,24 @@ json summarizeDataset(const Dataset& ds, double gap_factor, const ImuNoise& nois
   j["t_first"] = formatSeconds(t0);
   j["t_last"] = formatSeconds(t1);
   j["duration_s"] = seconds(t1 - t0);
+  if (!ds.bag_topics.empty()) j["bag_topics"] = bagTopicsJson(ds);
   j["warnings"] = ds.warnings;
   return j;
+}
+
+json bagTopicsJson(const Dataset& ds) {
+  json topics = json::array();
+  for (const BagTopicUse& t : ds.bag_topics) {
+    topics.push_back({{"role", t.role},
+                      {"topic", t.topic},
+                      {"type", t.type},
+                      {"messages", t.messages},
+                      {"used", t.used},
+                      {"out_of_order_sorted", t.out_of_order},
+                      {"repeated_stamps_dropped", t.duplicate_stamps},
+                      {"zero_header_stamps", t.zero_stamps}});
+  }
+  return topics;
 }
 
 std::string formatSummary(const json& j) {
@@ -219,6 +235,13 @@ std::string formatSummary(const json& j) {
   stream("groundtruth", "truth");
   if (j.contains("groundtruth")) {
     out += fmt::format("  path length {:.1f} m\n", j["groundtruth"]["path_length_m"].get<double>());
+  }
+  for (const auto& t : j.value("bag_topics", json::array())) {
+    out += fmt::format("topic     {:<4} {} ({}): {} messages, {} used, {} sorted, {} dropped\n",
+                       t["role"].get<std::string>(), t["topic"].get<std::string>(),
+                       t["type"].get<std::string>(), t["messages"].get<std::size_t>(),
+                       t["used"].get<std::size_t>(), t["out_of_order_sorted"].get<std::size_t>(),
+                       t["repeated_stamps_dropped"].get<std::size_t>());
   }
   for (const auto& w : j["warnings"]) out += "warning   " + w.get<std::string>() + "\n";
   return out;

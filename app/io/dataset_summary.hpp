@@ -30,4 +30,8 @@ nlohmann::json summarizeDataset(const Dataset& dataset, double gap_factor,
 
 std::string formatSummary(const nlohmann::json& summary);
 
+// A ROS bag's topics: role, topic, type, messages, used, and the repairs (sorted, dropped,
+// zero stamps); an empty array for other formats. In inspect's summary and report.json.
+nlohmann::json bagTopicsJson(const Dataset& dataset);
+
 }  // namespace gvio::io

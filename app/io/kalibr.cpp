@@ -131,6 +131,7 @@ KalibrCalibration readKalibr(const std::vector<fs::path>& files) {
       const std::string name = "cam" + std::to_string(i);
       const YAML::Node block = root[name];
       previous = readCamera(block, name, previous, file, out);
+      out.camera_topics.push_back(block["rostopic"] ? scalar(block, "rostopic", file) : "");
       const double shift =
           block["timeshift_cam_imu"] ? number(block, "timeshift_cam_imu", file) : 0.0;
       if (i == 0) {
@@ -146,6 +147,7 @@ KalibrCalibration readKalibr(const std::vector<fs::path>& files) {
     const YAML::Node imu = root["imu0"] ? root["imu0"] : root;
     if (imu["accelerometer_noise_density"] || imu["gyroscope_noise_density"]) {
       out.imu_noise = readImuNoise(imu, file);
+      if (imu["rostopic"]) out.imu_topic = scalar(imu, "rostopic", file);
       used = true;
     }
     if (!used) {
@@ -163,6 +165,18 @@ void applyKalibr(Dataset& ds, const KalibrCalibration& c) {
     if (c.cameras.size() != ds.cameras.size()) {
       throw InvalidInput(fmt::format("--calib: the camera chain has {} camera(s), the dataset {}",
                                      c.cameras.size(), ds.cameras.size()));
+    }
+    for (std::size_t i = 0; i < c.cameras.size(); ++i) {
+      const CameraModel& from_images = ds.cameras[i];
+      const CameraModel& calibrated = c.cameras[i];
+      if (from_images.fx == 0.0 && from_images.width_px > 0 &&
+          (from_images.width_px != calibrated.width_px ||
+           from_images.height_px != calibrated.height_px)) {
+        throw InvalidInput(fmt::format(
+            "--calib: {} is calibrated for {}x{} pixels, the dataset's images are {}x{}",
+            calibrated.name, calibrated.width_px, calibrated.height_px, from_images.width_px,
+            from_images.height_px));
+      }
     }
     ds.cameras = c.cameras;
   }

@@ -23,6 +23,9 @@ struct KalibrCalibration {
   std::vector<CameraModel> cameras;  // cam0, cam1, ... in order (name "cam0", ...)
   double timeshift_cam_imu_s = 0.0;  // cam0's (every camera of a chain shares the trigger)
   std::optional<ImuNoise> imu_noise;
+  // The rostopic each camera (and the IMU) was calibrated from; empty where the file names none.
+  std::vector<std::string> camera_topics;
+  std::string imu_topic;
   std::vector<std::string> warnings;
 };
 
@@ -30,7 +33,8 @@ struct KalibrCalibration {
 // InputError when no file holds a camera or IMU block, or on a bad block.
 KalibrCalibration readKalibr(const std::vector<std::filesystem::path>& files);
 
-// Replaces the dataset's cameras (when the calibration has them: as many as the dataset's) and
+// Replaces the dataset's cameras (when the calibration has them: as many as the dataset's; a
+// camera whose size came from its images (a bag) must match the calibrated resolution) and
 // IMU noise (when given), and shifts every frame stamp by timeshift_cam_imu into the IMU's clock.
 void applyKalibr(Dataset& ds, const KalibrCalibration& calibration);
 

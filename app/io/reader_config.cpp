@@ -32,6 +32,13 @@ void ReaderConfig::validate() const {
   requirePositive(nmea_vertical_factor, "dataset.nmea_vertical_factor");
   requirePositive(comma2k19_sigma_h_m, "dataset.comma2k19_sigma_h_m");
   requirePositive(comma2k19_sigma_v_m, "dataset.comma2k19_sigma_v_m");
+  if (!std::isfinite(stereo_sync_tolerance_s) || stereo_sync_tolerance_s < 0.0) {
+    throw InvalidInput("config: dataset.stereo_sync_tolerance_s must be >= 0 (got " +
+                       std::to_string(stereo_sync_tolerance_s) + ")");
+  }
+  if (topic_cam0.empty() && !topic_cam1.empty()) {
+    throw InvalidInput("config: dataset.topics.cam1 is set but dataset.topics.cam0 is not");
+  }
 }
 
 }  // namespace gvio::io

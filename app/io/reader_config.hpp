@@ -20,6 +20,12 @@ struct ReaderConfig {
   // comma2k19's u-blox CSV has no accuracy columns: 1-sigma horizontal (per axis) and vertical.
   double comma2k19_sigma_h_m = 1.0;
   double comma2k19_sigma_v_m = 2.0;
+  // ROS bags (dataset.topics.*): the topic of each role; empty = the only topic of the role's
+  // message type (two image topics that differ only in 0/1, 1/2, left/right or l/r are a stereo
+  // pair), or the one the Kalibr camchain's rostopic names.
+  std::string topic_cam0, topic_cam1, topic_imu, topic_gnss;
+  // Two cameras' images are one stereo frame when their stamps differ by at most this.
+  double stereo_sync_tolerance_s = 0.003;
 
   void validate() const;  // throws InvalidInput naming the key
 };

@@ -6,8 +6,7 @@
 #include <cmath>
 
 #include "io/atomic_write.hpp"
-#include "io/gnss_file.hpp"
-#include "io/kalibr.hpp"
+#include "io/dataset_sources.hpp"
 #include "io/trajectory_io.hpp"
 #include "odometry/error.hpp"
 #include "run/ins_run.hpp"
@@ -60,11 +59,9 @@ void makeOutputDir(const fs::path& out) {
 }
 
 void loadDataset(RunState& s) {
-  s.dataset = io::readDataset(s.request.dataset, s.request.format, s.config.dataset);
-  if (!s.request.calib_files.empty()) {
-    io::applyKalibr(s.dataset, io::readKalibr(s.request.calib_files));
-  }
-  if (s.request.gnss_file) io::useGnssFile(s.dataset, *s.request.gnss_file, s.config.dataset);
+  s.dataset = io::openDataset(
+      {s.request.dataset, s.request.format, s.request.calib_files, s.request.gnss_file},
+      s.config.dataset);
   for (const auto& w : s.dataset.warnings) spdlog::warn("{}", w);
   s.gnss_noise = degradeGnss(s.dataset, s.request);
 }

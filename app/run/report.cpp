@@ -1,5 +1,6 @@
 #include "run/report.hpp"
 
+#include "io/dataset_summary.hpp"
 #include "run/stats.hpp"
 
 namespace gvio::run {
@@ -32,15 +33,17 @@ json evaluationJson(const EvaluationOutcome& outcome) {
 }  // namespace
 
 json datasetJson(const io::Dataset& ds) {
-  return {{"path", ds.root.string()},
-          {"format", io::toString(ds.format)},
-          {"variant", ds.variant},
-          {"cameras", ds.cameras.size()},
-          {"frames", ds.frames.size()},
-          {"imu_samples", ds.imu.size()},
-          {"imu_rate_hz", imuRateHz(ds)},
-          {"gnss_fixes", ds.gnss.size()},
-          {"groundtruth", ds.groundtruth ? json(ds.groundtruth_source) : json(nullptr)}};
+  json j = {{"path", ds.root.string()},
+            {"format", io::toString(ds.format)},
+            {"variant", ds.variant},
+            {"cameras", ds.cameras.size()},
+            {"frames", ds.frames.size()},
+            {"imu_samples", ds.imu.size()},
+            {"imu_rate_hz", imuRateHz(ds)},
+            {"gnss_fixes", ds.gnss.size()},
+            {"groundtruth", ds.groundtruth ? json(ds.groundtruth_source) : json(nullptr)}};
+  if (!ds.bag_topics.empty()) j["bag_topics"] = io::bagTopicsJson(ds);
+  return j;
 }
 
 json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportContext& ctx) {

@@ -20,37 +20,37 @@
 
 namespace gvio::run {
 namespace {
-namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using odometry::VioMode;
 
 // A real recording may list images that are missing or damaged: each skips its frame. The first
-// one per folder is a warning, the rest are counted, so a long gap does not flood the log.
+// one per folder (or bag topic) is a warning, the rest are counted, so a long gap does not flood
+// the log.
 class UnreadableImages {
  public:
-  std::optional<cv::Mat> load(const fs::path& file, const CameraModel& camera) {
+  std::optional<cv::Mat> load(const io::Dataset& ds, std::size_t frame, std::size_t camera) {
     try {
-      return io::loadGrayImage(file, camera);
+      return io::loadFrameImage(ds, frame, camera);
     } catch (const io::InputError& e) {
-      Folder& folder = folders_[file.parent_path()];
-      if (folder.count++ == 0) spdlog::warn("{} (frame skipped)", e.what());
+      Source& source = sources_[io::imageSource(ds, frame, camera)];
+      if (source.count++ == 0) spdlog::warn("{} (frame skipped)", e.what());
       return std::nullopt;
     }
   }
   void logSummary() const {
-    for (const auto& [dir, folder] : folders_) {
-      if (folder.count > 1) {
-        spdlog::warn("{}: {} images could not be read, their frames were skipped", dir.string(),
-                     folder.count);
+    for (const auto& [name, source] : sources_) {
+      if (source.count > 1) {
+        spdlog::warn("{}: {} images could not be read, their frames were skipped", name,
+                     source.count);
       }
     }
   }
 
  private:
-  struct Folder {
+  struct Source {
     int count = 0;
   };
-  std::map<fs::path, Folder> folders_;
+  std::map<std::string, Source> sources_;
 };
 
 // Every event goes to report.json; the state changes a user watches for (waiting for motion,
@@ -116,13 +116,13 @@ struct LoadedFrame {
   double load_ms = 0.0, rectify_ms = 0.0;
 };
 
-LoadedFrame loadFrame(const io::Dataset& ds, const io::FrameRecord& frame, bool stereo,
+LoadedFrame loadFrame(const io::Dataset& ds, std::size_t frame, bool stereo,
                       const odometry::Rectifier& rectifier, UnreadableImages& unreadable) {
   LoadedFrame f;
   const auto t_load = Clock::now();
-  std::optional<cv::Mat> left = unreadable.load(frame.image_paths[0], ds.cameras[0]);
+  std::optional<cv::Mat> left = unreadable.load(ds, frame, 0);
   std::optional<cv::Mat> right;
-  if (left && stereo) right = unreadable.load(frame.image_paths[1], ds.cameras[1]);
+  if (left && stereo) right = unreadable.load(ds, frame, 1);
   if (!left || (stereo && !right)) return f;
   f.load_ms = msSince(t_load);
   const auto t_rectify = Clock::now();
@@ -174,7 +174,7 @@ VioRunResult runVio(const io::Dataset& ds, odometry::EstimatorConfig config,
   UnreadableImages unreadable;  // used by the decoding side only
   Prefetcher<LoadedFrame> frames(threaded, 4, [&](std::size_t i) -> std::optional<LoadedFrame> {
     if (i >= ds.frames.size()) return std::nullopt;
-    return loadFrame(ds, ds.frames[i], stereo, rectifier, unreadable);
+    return loadFrame(ds, i, stereo, rectifier, unreadable);
   });
   OrderedWorker keyframe_work(threaded, 4);
   FrameStepper stepper(estimator, threaded);

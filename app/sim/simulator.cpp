@@ -4,6 +4,8 @@
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
+#include <optional>
+
 #include "io/atomic_write.hpp"
 #include "io/image_loader.hpp"
 #include "io/input_error.hpp"
@@ -11,6 +13,7 @@
 #include "io/mesh_ply.hpp"
 #include "io/text.hpp"
 #include "io/trajectory_io.hpp"
+#include "sim/bag_output.hpp"
 #include "sim/camera_sim.hpp"
 #include "sim/dataset_writers.hpp"
 #include "sim/imu_synth.hpp"
@@ -132,6 +135,20 @@ io::TriangleMesh worldMesh(const render::Scene& scene) {
   return mesh;
 }
 
+CameraModel cameraModel(const render::PinholeIntrinsics& K, const Eigen::Isometry3d& T_b_c,
+                        std::size_t index) {
+  CameraModel cam;
+  cam.name = "cam" + std::to_string(index);
+  cam.width_px = K.width;
+  cam.height_px = K.height;
+  cam.fx = K.fx;
+  cam.fy = K.fy;
+  cam.cx = K.cx;
+  cam.cy = K.cy;
+  cam.T_b_c = T_b_c;
+  return cam;
+}
+
 // Every parameter of the run: the request, the effective configuration, and what came out.
 void writeSimYaml(const fs::path& file, const SimRequest& r, const SimSummary& s) {
   YAML::Emitter y;
@@ -183,8 +200,9 @@ void writeSimYaml(const fs::path& file, const SimRequest& r, const SimSummary& s
 SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise& imu_noise,
                     const ProgressFn& progress) {
   config.validate();
-  if (r.output != io::DatasetFormat::kKittiRaw && r.output != io::DatasetFormat::kEuroc) {
-    throw InvalidInput("--format: the simulator writes kitti-raw or euroc");
+  if (r.output != io::DatasetFormat::kKittiRaw && r.output != io::DatasetFormat::kEuroc &&
+      r.output != io::DatasetFormat::kRosbag) {
+    throw InvalidInput("--format: the simulator writes kitti-raw, euroc or rosbag");
   }
   if (r.seconds && !(*r.seconds > 0.0)) throw InvalidInput("--seconds must be positive");
   const Trajectory poses = loadBodyPoses(r, config);
@@ -254,12 +272,18 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
   summary.egl = context.info().platform + ": " + context.info().gl_renderer;
   CameraSimulator cameras(context, world.scene, K, T_b_c, config, mixSeed(r.seed, 4));
   const bool kitti = r.output == io::DatasetFormat::kKittiRaw;
+  std::optional<BagOutput> bag;
+  if (r.output == io::DatasetFormat::kRosbag) bag.emplace(r.out);
   std::vector<std::int64_t> frame_t;
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / config.camera_rate_hz));
   for (std::int64_t t = traj.t0_ns(); t <= t1; t += period_ns) frame_t.push_back(t);
   for (std::size_t k = 0; k < frame_t.size(); ++k) {
     for (std::size_t c = 0; c < T_b_c.size(); ++c) {
       const cv::Mat image = cameras.render(traj, frame_t[k], c, k);
+      if (bag) {
+        bag->writeImage(frame_t[k], c, image);
+        continue;
+      }
       const fs::path file =
           kitti ? kittiImagePath(r.out, ids[c], k) : eurocImagePath(r.out, ids[c], frame_t[k]);
       fs::create_directories(file.parent_path());
@@ -276,6 +300,10 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
     fs::create_directories(r.out / "gnss");
     io::writeTextAtomic(r.out / "gnss" / "fixes.nmea", toNmeaLog(fixes));
     io::writeTextAtomic(r.out / "gnss" / "data.csv", toGnssCsv(fixes));
+  } else if (bag) {
+    std::vector<CameraModel> models;
+    for (std::size_t c = 0; c < ids.size(); ++c) models.push_back(cameraModel(K, T_b_c[c], c));
+    bag->finish(imu, fixes, models, summary.imu_noise.noise, config.imu_rate_hz);
   } else {
     for (std::size_t c = 0; c < ids.size(); ++c)
       writeEurocCamera(r.out, ids[c], frame_t, K, T_b_c[c], config.camera_rate_hz);

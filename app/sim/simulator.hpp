@@ -24,7 +24,7 @@ struct SimRequest {
   // Where the body's orientation comes from: the file's (checked against the direction of travel,
   // with a warning) or derived from the path (heading and pitch from the direction of travel).
   OrientationSource orientation = OrientationSource::kFile;
-  io::DatasetFormat output = io::DatasetFormat::kKittiRaw;  // kitti-raw or euroc
+  io::DatasetFormat output = io::DatasetFormat::kKittiRaw;  // kitti-raw, euroc or rosbag
   std::optional<double> seconds;                            // simulate only the first S seconds
   bool stereo = true;
   GnssNoise gnss = GnssNoise::kSpp;

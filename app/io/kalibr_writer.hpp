@@ -1,0 +1,19 @@
+#pragma once
+// Kalibr calibration files as Kalibr writes them (camchain.yaml, imu.yaml), for drives gvio
+// writes itself (gvio simulate --format rosbag); io/kalibr.hpp reads them back.
+#include <string>
+#include <vector>
+
+#include "odometry/measurements.hpp"
+
+namespace gvio::io {
+
+// camN blocks: pinhole intrinsics, radtan distortion (zeros when none), resolution, T_cam_imu
+// (= T_b_c^-1, the body being the IMU), T_cn_cnm1 from cam1 on, timeshift_cam_imu and rostopic.
+std::string kalibrCamchainYaml(const std::vector<CameraModel>& cameras,
+                               const std::vector<std::string>& topics, double timeshift_cam_imu_s);
+
+// imu0 block: noise densities, random walks, rate and rostopic.
+std::string kalibrImuYaml(const ImuNoise& noise, double rate_hz, const std::string& topic);
+
+}  // namespace gvio::io

@@ -1,0 +1,126 @@
+// sensor_msgs/Image and CompressedImage payloads to 8-bit grey (issue 16): every accepted
+// encoding, padded rows, 16-bit in either byte order, PNG and JPEG, and the refusals.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "io/ros_image.hpp"
+#include "odometry/error.hpp"
+
+namespace gvio::io {
+namespace {
+using testing::HasSubstr;
+
+cv::Mat gradient() {
+  cv::Mat g(6, 10, CV_8UC1);
+  for (int r = 0; r < g.rows; ++r) {
+    for (int c = 0; c < g.cols; ++c)
+      g.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(20 * r + 7 * c);
+  }
+  return g;
+}
+
+bag::ImageMessage raw(const cv::Mat& m, const std::string& encoding, int pad_bytes = 0) {
+  bag::ImageMessage out;
+  out.encoding = encoding;
+  out.width = static_cast<std::uint32_t>(m.cols);
+  out.height = static_cast<std::uint32_t>(m.rows);
+  const std::size_t row = m.cols * m.elemSize();
+  out.step = static_cast<std::uint32_t>(row + static_cast<std::size_t>(pad_bytes));
+  out.data.assign(out.step * out.height, 0xAB);  // padding bytes must be ignored
+  for (int r = 0; r < m.rows; ++r) std::memcpy(&out.data[r * out.step], m.ptr(r), row);
+  return out;
+}
+
+std::string error(const bag::ImageMessage& m) {
+  try {
+    (void)rosImageToGray(m);
+  } catch (const InvalidInput& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(RosImage, Mono8WithPaddedRowsAndItsAlias) {
+  const cv::Mat g = gradient();
+  EXPECT_EQ(cv::norm(rosImageToGray(raw(g, "mono8", 6)), g, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(rosImageToGray(raw(g, "8UC1")), g, cv::NORM_INF), 0.0);
+  const bag::ImageMessage round_trip = grayToRosImage(g, false);
+  EXPECT_EQ(cv::norm(rosImageToGray(round_trip), g, cv::NORM_INF), 0.0);
+}
+
+TEST(RosImage, ColourToGreyWithOpenCvWeights) {
+  cv::Mat bgr(6, 10, CV_8UC3, cv::Scalar(200, 100, 50));  // B, G, R
+  cv::Mat expected;
+  cv::cvtColor(bgr, expected, cv::COLOR_BGR2GRAY);
+  EXPECT_EQ(cv::norm(rosImageToGray(raw(bgr, "bgr8")), expected, cv::NORM_INF), 0.0);
+  cv::Mat rgb;
+  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+  EXPECT_EQ(cv::norm(rosImageToGray(raw(rgb, "rgb8")), expected, cv::NORM_INF), 0.0);
+  cv::Mat rgba;
+  cv::cvtColor(bgr, rgba, cv::COLOR_BGR2RGBA);
+  EXPECT_EQ(cv::norm(rosImageToGray(raw(rgba, "rgba8")), expected, cv::NORM_INF), 0.0);
+  // Not the same as reading the channels in the wrong order.
+  cv::Mat swapped;
+  cv::cvtColor(bgr, swapped, cv::COLOR_RGB2GRAY);
+  EXPECT_GT(cv::norm(swapped, expected, cv::NORM_INF), 10.0);
+}
+
+TEST(RosImage, Mono16InEitherByteOrderScaledBy256) {
+  cv::Mat wide(2, 3, CV_16UC1);
+  for (int i = 0; i < 6; ++i)
+    wide.at<std::uint16_t>(i / 3, i % 3) = static_cast<std::uint16_t>(i * 10000 + 300);
+  bag::ImageMessage little = raw(wide, "mono16");
+  const cv::Mat a = rosImageToGray(little);
+  ASSERT_EQ(a.type(), CV_8UC1);
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_EQ(a.at<std::uint8_t>(i / 3, i % 3), cvRound((i * 10000 + 300) / 256.0)) << i;
+  }
+  bag::ImageMessage big = little;
+  big.big_endian = true;
+  for (std::size_t i = 0; i + 1 < big.data.size(); i += 2) std::swap(big.data[i], big.data[i + 1]);
+  EXPECT_EQ(cv::norm(rosImageToGray(big), a, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(rosImageToGray(raw(wide, "16UC1")), a, cv::NORM_INF), 0.0);
+}
+
+TEST(RosImage, CompressedPngAndJpeg) {
+  const cv::Mat g = gradient();
+  const bag::ImageMessage png = grayToRosImage(g, true);
+  EXPECT_TRUE(png.compressed);
+  EXPECT_EQ(cv::norm(rosImageToGray(png), g, cv::NORM_INF), 0.0);
+  bag::ImageMessage jpeg;
+  jpeg.compressed = true;
+  jpeg.format = "bgr8; jpeg compressed bgr8";
+  cv::Mat bgr;
+  cv::cvtColor(g, bgr, cv::COLOR_GRAY2BGR);
+  cv::imencode(".jpg", bgr, jpeg.data, {cv::IMWRITE_JPEG_QUALITY, 100});
+  EXPECT_LE(cv::norm(rosImageToGray(jpeg), g, cv::NORM_INF), 3.0);
+}
+
+TEST(RosImage, RefusalsSayWhatIsWrong) {
+  const cv::Mat g = gradient();
+  EXPECT_THAT(error(raw(g, "bayer_rggb8")),
+              HasSubstr("image encoding 'bayer_rggb8' is not supported (mono8, 8UC1"));
+  bag::ImageMessage short_data = raw(g, "mono8");
+  short_data.data.resize(short_data.data.size() - 1);
+  EXPECT_THAT(error(short_data), HasSubstr("does not fit its 59 bytes"));
+  bag::ImageMessage narrow_step = raw(g, "mono8");
+  narrow_step.step = 5;
+  EXPECT_THAT(error(narrow_step), HasSubstr("with step 5"));
+  bag::ImageMessage depth = grayToRosImage(g, true);
+  depth.format = "16UC1; compressedDepth png";
+  EXPECT_THAT(error(depth),
+              HasSubstr("compressed image format '16UC1; compressedDepth png' is not"));
+  bag::ImageMessage garbage = grayToRosImage(g, true);
+  garbage.data.assign(40, 7);
+  EXPECT_THAT(error(garbage), HasSubstr("cannot be decoded"));
+  bag::ImageMessage empty = raw(g, "mono8");
+  empty.width = 0;
+  EXPECT_THAT(error(empty), HasSubstr("image of 0x6 pixels"));
+}
+
+}  // namespace
+}  // namespace gvio::io
