@@ -161,7 +161,8 @@ TrackedFrame FeatureTracker::track(std::int64_t t_ns, const cv::Mat& left, const
 
   auto start = Clock::now();
   buildPyramid(left, left_pyr_);
-  if (has_prev_ && !tracks_.empty()) trackPrevious(stats);
+  if (has_prev_ && !tracks_.empty())
+    trackPrevious(1e-9 * static_cast<double>(t_ns - prev_t_ns_), stats);
   stats.ms_track = msSince(start);
 
   start = Clock::now();
@@ -175,14 +176,15 @@ TrackedFrame FeatureTracker::track(std::int64_t t_ns, const cv::Mat& left, const
     out.features = matchStereo(stats);
   } else {
     for (const Track& t : tracks_) {
-      out.features.push_back(
-          Feature{t.id, toEigen(t.px), false, Eigen::Vector2d::Zero(), t.length});
+      out.features.push_back(Feature{t.id, toEigen(t.px), false, Eigen::Vector2d::Zero(), t.length,
+                                     toEigen(t.velocity_pxps)});
     }
   }
   stats.ms_stereo = msSince(start);
 
   std::swap(prev_pyr_, left_pyr_);  // this frame's pyramid is the next one's "previous"
   has_prev_ = true;
+  prev_t_ns_ = t_ns;
   return out;
 }
 
@@ -213,12 +215,14 @@ void FeatureTracker::buildPyramid(const cv::Mat& image, std::vector<cv::Mat>& py
                               false);
 }
 
-void FeatureTracker::trackPrevious(TrackerStats& stats) {
+void FeatureTracker::trackPrevious(double dt_s, TrackerStats& stats) {
   std::vector<cv::Point2f> prev_px(tracks_.size()), cur_px;
   for (std::size_t i = 0; i < tracks_.size(); ++i) prev_px[i] = tracks_[i].px;
   std::vector<bool> ok = kltForwardBackward(prev_pyr_, left_pyr_, prev_px, cur_px, false, config_);
   for (std::size_t i = 0; i < ok.size(); ++i) {
     ok[i] = ok[i] && inside(cur_px[i], image_size_);
+    tracks_[i].velocity_pxps =
+        dt_s > 0.0 ? (cur_px[i] - prev_px[i]) * static_cast<float>(1.0 / dt_s) : cv::Point2f();
     tracks_[i].px = cur_px[i];
     ++tracks_[i].length;
   }
@@ -361,7 +365,8 @@ std::vector<Feature> FeatureTracker::matchStereo(TrackerStats& stats) {
       ++stats.rejected_stereo;
     }
     features.push_back(Feature{t.id, toEigen(l), match,
-                               match ? toEigen(r) : Eigen::Vector2d::Zero().eval(), t.length});
+                               match ? toEigen(r) : Eigen::Vector2d::Zero().eval(), t.length,
+                               toEigen(t.velocity_pxps)});
   }
   return features;
 }

@@ -35,6 +35,9 @@ struct Feature {
   bool has_right = false;
   Eigen::Vector2d px_right = Eigen::Vector2d::Zero();  // valid when has_right
   int track_length = 1;  // frames this id has been seen in, this one included
+  // Image-plane velocity of the left pixel since the previous frame (px/s; zero for a new
+  // feature): the time-offset factors shift observations along it.
+  Eigen::Vector2d velocity_pxps = Eigen::Vector2d::Zero();
 };
 
 struct TrackerStats {
@@ -83,6 +86,7 @@ class FeatureTracker {
   struct Track {
     std::uint64_t id = 0;
     cv::Point2f px;
+    cv::Point2f velocity_pxps{0.0F, 0.0F};
     int length = 1;
     bool has_disparity = false;
     float disparity = 0.0F;  // left x - right x in the frame it was measured, a stereo KLT guess
@@ -90,7 +94,7 @@ class FeatureTracker {
 
   void checkImages(const cv::Mat& left, const cv::Mat& right) const;
   void buildPyramid(const cv::Mat& image, std::vector<cv::Mat>& pyr) const;
-  void trackPrevious(TrackerStats& stats);
+  void trackPrevious(double dt_s, TrackerStats& stats);
   void rejectOutliersRansac(const std::vector<cv::Point2f>& prev_px, TrackerStats& stats);
   void thinOutAndMask(const cv::Size& size);
   std::vector<cv::Point2f> shiTomasiCorners(const cv::Mat& image);
@@ -99,8 +103,9 @@ class FeatureTracker {
 
   TrackerConfig config_;
   std::uint64_t next_id_ = 0;
-  std::vector<Track> tracks_;  // features of the previous (then current) left image
-  bool has_prev_ = false;      // prev_pyr_ holds the previous left image (false after reset())
+  std::vector<Track> tracks_;   // features of the previous (then current) left image
+  bool has_prev_ = false;       // prev_pyr_ holds the previous left image (false after reset())
+  std::int64_t prev_t_ns_ = 0;  // its stamp
   cv::Size image_size_;
   // Image buffers kept from frame to frame only so that OpenCV reuses their memory: fresh
   // megabyte-sized allocations each frame cost more in page faults than the arithmetic on them.

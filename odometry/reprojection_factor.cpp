@@ -37,46 +37,58 @@ ReprojectionFactor::ReprojectionFactor(const Eigen::Vector3d& bearing_anchor,
       px_(px_observed),
       inv_sigma_(1.0 / sigma_px) {}
 
-bool ReprojectionFactor::Evaluate(double const* const* parameters, double* residuals,
-                                  double** jacobians) const {
-  const Eigen::Matrix3d R_i = poseQ(parameters[0]).normalized().toRotationMatrix();
-  const Eigen::Vector3d p_i = poseP(parameters[0]);
-  const Eigen::Matrix3d R_j = poseQ(parameters[1]).normalized().toRotationMatrix();
-  const Eigen::Vector3d p_j = poseP(parameters[1]);
-  const double rho = parameters[2][0];
+bool anchoredResidual(const Eigen::Vector3d& u_a, const Eigen::Isometry3d& T_b_ca,
+                      const PinholeView& observer, const Eigen::Vector2d& px, double inv_sigma,
+                      double const* pose_i, double const* pose_j, double rho, double* residuals,
+                      double* J_pose_i, double* J_pose_j, Eigen::Matrix<double, 2, 3>* J_ca) {
+  const Eigen::Matrix3d R_i = poseQ(pose_i).normalized().toRotationMatrix();
+  const Eigen::Vector3d p_i = poseP(pose_i);
+  const Eigen::Matrix3d R_j = poseQ(pose_j).normalized().toRotationMatrix();
+  const Eigen::Vector3d p_j = poseP(pose_j);
   if (!(rho > 0.0)) return false;
 
-  const Eigen::Vector3d P_ca = bearing_ / rho;
-  const Eigen::Vector3d P_bi = T_b_ca_ * P_ca;
+  const Eigen::Vector3d P_ca = u_a / rho;
+  const Eigen::Vector3d P_bi = T_b_ca * P_ca;
   const Eigen::Vector3d P_w = R_i * P_bi + p_i;
   const Eigen::Vector3d P_bj = R_j.transpose() * (P_w - p_j);
-  const Eigen::Matrix3d R_co_b = observer_.T_b_c.rotation().transpose();
-  const Eigen::Vector3d P_co = R_co_b * (P_bj - observer_.T_b_c.translation());
+  const Eigen::Matrix3d R_co_b = observer.T_b_c.rotation().transpose();
+  const Eigen::Vector3d P_co = R_co_b * (P_bj - observer.T_b_c.translation());
 
-  Eigen::Map<Eigen::Vector2d> r(residuals);
   Eigen::Vector2d r_value;
   Eigen::Matrix<double, 2, 3> J_proj;
-  if (!projectResidual(observer_, P_co, px_, inv_sigma_, r_value, &J_proj)) return false;
-  r = r_value;
-  if (jacobians == nullptr) return true;
+  if (!projectResidual(observer, P_co, px, inv_sigma, r_value, &J_proj)) return false;
+  Eigen::Map<Eigen::Vector2d>{residuals} = r_value;
 
   // Chain rule through P_co = R_co_b R_j^T (P_w - p_j) - ...; perturbations R Exp(dphi), p + R dp.
   const Eigen::Matrix<double, 2, 3> J_w = J_proj * R_co_b * R_j.transpose();
-  if (jacobians[0] != nullptr) {
+  if (J_pose_i != nullptr) {
     Eigen::Matrix<double, 2, 6> J_t;
     J_t << -J_w * R_i * hat(P_bi), J_w * R_i;  // dP_w/dphi_i = -R_i hat(P_bi), dP_w/dp_i = R_i
-    Eigen::Map<Jac2x7>{jacobians[0]} = J_t * poseMinusJacobian(parameters[0]);
+    Eigen::Map<Jac2x7>{J_pose_i} = J_t * poseMinusJacobian(pose_i);
   }
-  if (jacobians[1] != nullptr) {
+  if (J_pose_j != nullptr) {
     Eigen::Matrix<double, 2, 6> J_t;
     const Eigen::Matrix<double, 2, 3> J_bj = J_proj * R_co_b;
     J_t << J_bj * hat(P_bj), -J_bj;  // dP_bj/dphi_j = hat(P_bj), dP_bj/dp_j = -I
-    Eigen::Map<Jac2x7>{jacobians[1]} = J_t * poseMinusJacobian(parameters[1]);
+    Eigen::Map<Jac2x7>{J_pose_j} = J_t * poseMinusJacobian(pose_j);
   }
-  if (jacobians[2] != nullptr) {
+  if (J_ca != nullptr) *J_ca = J_w * R_i * T_b_ca.rotation();
+  return true;
+}
+
+bool ReprojectionFactor::Evaluate(double const* const* parameters, double* residuals,
+                                  double** jacobians) const {
+  const double rho = parameters[2][0];
+  Eigen::Matrix<double, 2, 3> J_ca;
+  const bool want = jacobians != nullptr;
+  if (!anchoredResidual(bearing_, T_b_ca_, observer_, px_, inv_sigma_, parameters[0], parameters[1],
+                        rho, residuals, want ? jacobians[0] : nullptr,
+                        want ? jacobians[1] : nullptr, &J_ca)) {
+    return false;
+  }
+  if (want && jacobians[2] != nullptr) {
     // dP_ca/drho = -u_a / rho^2.
-    Eigen::Map<Eigen::Vector2d>{jacobians[2]} =
-        J_w * R_i * T_b_ca_.rotation() * (-bearing_ / (rho * rho));
+    Eigen::Map<Eigen::Vector2d>{jacobians[2]} = J_ca * (-bearing_ / (rho * rho));
   }
   return true;
 }

@@ -53,6 +53,15 @@ class SameFrameReprojectionFactor final : public ceres::SizedCostFunction<2, 1> 
   double inv_sigma_;
 };
 
+// The residual of anchor bearing u_a (inverse depth rho, in camera T_b_ca of pose_i) seen at
+// `px` by `observer` of pose_j, with the 2x7 pose Jacobians (each optional, row-major) and
+// J_ca = d r / d P_ca (optional) for chain rules through the anchor point. False when the point is
+// behind a camera or rho <= 0.
+bool anchoredResidual(const Eigen::Vector3d& u_a, const Eigen::Isometry3d& T_b_ca,
+                      const PinholeView& observer, const Eigen::Vector2d& px, double inv_sigma,
+                      double const* pose_i, double const* pose_j, double rho, double* residuals,
+                      double* J_pose_i, double* J_pose_j, Eigen::Matrix<double, 2, 3>* J_ca);
+
 // Whitened pixel residual of P_c and its 2x3 Jacobian d r / d P_c (rows scaled by inv_sigma).
 // Returns false when the point is not in front of the camera (Z <= 1e-6).
 bool projectResidual(const PinholeView& cam, const Eigen::Vector3d& P_c, const Eigen::Vector2d& px,

@@ -5,6 +5,7 @@
 #include <ceres/solver.h>
 
 #include "odometry/imu_factor.hpp"
+#include "odometry/time_offset_factor.hpp"
 
 namespace gvio::odometry {
 namespace {
@@ -57,7 +58,18 @@ bool SlidingWindow::usable(const Landmark& lm) {
   return lm.has_depth && lm.observations.size() >= 2;
 }
 
-int SlidingWindow::landmarkFactors(Landmark& lm, const FactorSink& raw_sink) const {
+bool SlidingWindow::priorHoldsTimeOffset() const {
+  return prior_ && prior_->blockIndex(time_offset_s_.get()) >= 0;
+}
+
+std::shared_ptr<ceres::CostFunction> SlidingWindow::timeOffsetPrior() const {
+  const ceres::Matrix A = ceres::Matrix::Constant(1, 1, 1.0 / config_.time_offset_sigma_s);
+  const ceres::Vector b = ceres::Vector::Constant(1, time_offset_prior_mean_s_);
+  return std::make_shared<ceres::NormalPrior>(A, b);
+}
+
+int SlidingWindow::landmarkFactors(Landmark& lm, const FactorSink& raw_sink,
+                                   bool with_time_offset) const {
   if (!usable(lm)) return 0;
   WindowFrame* anchor = find(lm.anchor().frame_uid);
   if (anchor == nullptr) return 0;
@@ -75,6 +87,10 @@ int SlidingWindow::landmarkFactors(Landmark& lm, const FactorSink& raw_sink) con
     raw_sink(std::move(cost), l, std::move(blocks));
     ++forwarded;
   };
+  if (with_time_offset) {
+    timeOffsetFactors(lm, *anchor, sink);
+    return forwarded;
+  }
   if (geometry_.stereo && lm.anchor().has_right) {
     sink(std::make_shared<SameFrameReprojectionFactor>(
              bearing, geometry_.left.T_b_c, geometry_.right, lm.anchor().px_right, sigma),
@@ -94,6 +110,39 @@ int SlidingWindow::landmarkFactors(Landmark& lm, const FactorSink& raw_sink) con
     }
   }
   return forwarded;
+}
+
+// The same residuals with t_d as a block. The right image moves with the left one's velocity
+// (rectified pair: same rows, nearly the same flow).
+void SlidingWindow::timeOffsetFactors(Landmark& lm, const WindowFrame& anchor,
+                                      const FactorSink& sink) const {
+  double* t_d = time_offset_s_.get();
+  const double sigma = config_.pixel_sigma_px;
+  const ceres::LossFunction* loss = huber_.get();
+  const Observation& a = lm.anchor();
+  const MovingPixel anchor_px{a.px_left, a.velocity_pxps};
+  if (geometry_.stereo && a.has_right) {
+    sink(std::make_shared<SameFrameTimeOffsetFactor>(anchor_px, geometry_.left, geometry_.right,
+                                                     MovingPixel{a.px_right, a.velocity_pxps},
+                                                     sigma),
+         loss, {&lm.inv_depth, t_d});
+  }
+  double* anchor_pose = const_cast<double*>(anchor.pose.data());
+  for (std::size_t k = 1; k < lm.observations.size(); ++k) {
+    const Observation& o = lm.observations[k];
+    WindowFrame* f = find(o.frame_uid);
+    if (f == nullptr || f == &anchor) continue;
+    sink(std::make_shared<ReprojectionTimeOffsetFactor>(anchor_px, geometry_.left, geometry_.left,
+                                                        MovingPixel{o.px_left, o.velocity_pxps},
+                                                        sigma),
+         loss, {anchor_pose, f->pose.data(), &lm.inv_depth, t_d});
+    if (geometry_.stereo && o.has_right) {
+      sink(std::make_shared<ReprojectionTimeOffsetFactor>(
+               anchor_px, geometry_.left, geometry_.right, MovingPixel{o.px_right, o.velocity_pxps},
+               sigma),
+           loss, {anchor_pose, f->pose.data(), &lm.inv_depth, t_d});
+    }
+  }
 }
 
 void SlidingWindow::reintegrateIfNeeded() {
@@ -136,14 +185,18 @@ SolveStats SlidingWindow::solve(bool use_imu) {
           {a.pose.data(), a.speed_bias.data(), b.pose.data(), b.speed_bias.data()});
     }
   }
+  const bool with_time_offset = estimatesTimeOffset(use_imu);
   for (auto& [id, lm] : landmarks_.all()) {
-    if (landmarkFactors(lm, add) > 0) {
+    if (landmarkFactors(lm, add, with_time_offset) > 0) {
       ++stats.landmarks;
       problem.SetParameterLowerBound(&lm.inv_depth, 0, kMinInverseDepth);
     }
   }
   if (prior_) {
     add(std::make_shared<MarginalizationFactor>(prior_), nullptr, prior_->blockAddresses());
+  }
+  if (with_time_offset && !priorHoldsTimeOffset()) {
+    add(timeOffsetPrior(), nullptr, {time_offset_s_.get()});
   }
   bool anchored = false;
   for (const AnchorFactor& a : anchors_) {
@@ -198,18 +251,25 @@ void SlidingWindow::marginalizeOldest(bool use_imu) {
           {oldest.pose.data(), oldest.speed_bias.data(), next.pose.data(), next.speed_bias.data()});
       pose_named = speed_bias_named = true;
     }
+    const bool with_time_offset = estimatesTimeOffset(use_imu);
+    bool time_offset_named = false;
     const auto sink = [&](std::shared_ptr<ceres::CostFunction> cost,
                           const ceres::LossFunction* loss, std::vector<double*> blocks) {
+      time_offset_named = time_offset_named || blocks.back() == time_offset_s_.get();
       // The loss is owned by the window and outlives the marginaliser.
       m.addResidualBlock(std::move(cost), std::shared_ptr<const ceres::LossFunction>(huber_, loss),
                          blocks);
     };
     for (auto& [id, lm] : landmarks_.all()) {
       if (lm.anchor().frame_uid != oldest.uid) continue;
-      if (landmarkFactors(lm, sink) > 0) {
+      if (landmarkFactors(lm, sink, with_time_offset) > 0) {
         m.markForRemoval(&lm.inv_depth);
         pose_named = true;
       }
+    }
+    // The t_d prior is folded in once, with the first factors that take t_d into the prior.
+    if (time_offset_named && !priorHoldsTimeOffset()) {
+      m.addResidualBlock(timeOffsetPrior(), nullptr, {time_offset_s_.get()});
     }
     for (const AnchorFactor& a : anchors_) {
       if (a.frame_uid != oldest.uid || (a.speed_bias && !use_imu)) continue;
@@ -242,6 +302,7 @@ void SlidingWindow::dropNewest() {
 }
 
 void SlidingWindow::clear() {
+  time_offset_prior_mean_s_ = *time_offset_s_;  // the next window starts from the estimate
   frames_.clear();
   landmarks_.clear();
   prior_.reset();

@@ -78,19 +78,33 @@ class SlidingWindow {
   void dropNewest();
   // Clears frames, landmarks and prior.
   void clear();
-  void clearPrior() { prior_.reset(); }
+  void clearPrior() {
+    time_offset_prior_mean_s_ = *time_offset_s_;
+    prior_.reset();
+  }
   // Anchors the oldest frame with Gaussian priors around its current state; they join the
   // marginalisation prior when that frame leaves. Replaces anchors set before.
   void anchorOldest(const StartPrior& prior);
   // Landmarks usable by the optimisation (depth, and seen from two frames).
   [[nodiscard]] static bool usable(const Landmark& lm);
+  // The camera-IMU time offset t_d (s; odometry/time_offset_factor.hpp), a state of IMU solves
+  // when config.estimate_time_offset. It outlives clear(): a restart keeps the estimate.
+  [[nodiscard]] double timeOffsetS() const { return *time_offset_s_; }
 
  private:
   using FactorSink = std::function<void(std::shared_ptr<ceres::CostFunction>,
                                         const ceres::LossFunction*, std::vector<double*>)>;
   // Reprojection factors of one landmark (left, and right where matched) that evaluate at the
   // current state; returns how many were handed to `sink`.
-  int landmarkFactors(Landmark& lm, const FactorSink& sink) const;
+  int landmarkFactors(Landmark& lm, const FactorSink& sink, bool with_time_offset) const;
+  void timeOffsetFactors(Landmark& lm, const WindowFrame& anchor, const FactorSink& sink) const;
+  [[nodiscard]] bool estimatesTimeOffset(bool use_imu) const {
+    return use_imu && config_.estimate_time_offset;
+  }
+  // The prior on t_d (around its value when the window last started) while the marginalisation
+  // prior does not hold t_d yet.
+  [[nodiscard]] bool priorHoldsTimeOffset() const;
+  [[nodiscard]] std::shared_ptr<ceres::CostFunction> timeOffsetPrior() const;
   [[nodiscard]] WindowFrame* find(std::uint64_t uid) const;
   void reintegrateIfNeeded();
 
@@ -110,6 +124,9 @@ class SlidingWindow {
     bool speed_bias = false;  // on the speed/bias block (only in IMU solves)
   };
   std::vector<AnchorFactor> anchors_;
+  // Heap-held so that its address (the Ceres block) never moves with the window.
+  std::unique_ptr<double> time_offset_s_ = std::make_unique<double>(0.0);
+  double time_offset_prior_mean_s_ = 0.0;
 };
 
 }  // namespace gvio::odometry

@@ -58,6 +58,7 @@ void EstimatorConfig::validate() const {
   require(positive(init_tilt_sigma_deg), "init_tilt_sigma_deg", "> 0");
   require(positive(init_velocity_sigma_mps), "init_velocity_sigma_mps", "> 0");
   require(positive(acc_bias_prior_mps2), "acc_bias_prior_mps2", "> 0");
+  require(positive(time_offset_sigma_s), "time_offset_sigma_s", "> 0");
   require(positive(gyr_bias_prior_radps), "gyr_bias_prior_radps", "> 0");
   require(min_features_tracking >= 5, "min_features_tracking", ">= 5");
 }

@@ -51,6 +51,11 @@ struct EstimatorConfig {
   double init_velocity_sigma_mps = 0.5;
   double acc_bias_prior_mps2 = 0.1;
   double gyr_bias_prior_radps = 0.01;
+  // Camera-IMU time offset t_d (how much image stamps lag the exposures, s) as a window state
+  // (Qin and Shen 2018) whenever the IMU is in use; its prior around 0 (the calibration's
+  // timeshift is applied to the stamps before the estimator sees them).
+  bool estimate_time_offset = true;
+  double time_offset_sigma_s = 0.05;
 
   void validate() const;  // throws InvalidInput naming the field
 };

@@ -155,6 +155,7 @@ void VioEstimator::Impl::addObservations(const WindowFrame& f, const TrackedFram
     o.px_left = feat.px_left;
     o.has_right = geometry.stereo && feat.has_right;
     o.px_right = feat.px_right;
+    o.velocity_pxps = feat.velocity_pxps;
     if (window.landmarks().observe(feat.id, o)) continue;
     if (f.keyframe) {
       window.landmarks().create(feat.id, o, geometry, config.min_depth_m, config.max_depth_m);
@@ -340,6 +341,10 @@ std::vector<VioEvent> VioEstimator::takeEvents() {
 
 const VioCounters& VioEstimator::counters() const {
   return impl_->counters;
+}
+
+double VioEstimator::timeOffsetS() const {
+  return impl_->window.timeOffsetS();
 }
 
 const std::vector<Feature>& VioEstimator::lastFeatures() const {

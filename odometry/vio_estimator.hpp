@@ -109,6 +109,9 @@ class VioEstimator {
   // Events since the last call (moved out).
   std::vector<VioEvent> takeEvents();
   [[nodiscard]] const VioCounters& counters() const;
+  // The camera-IMU time offset estimate t_d (image stamps minus exposures, s): 0 until an IMU
+  // window estimates it (vio.estimate_time_offset), kept through restarts.
+  [[nodiscard]] double timeOffsetS() const;
   // The front end's features of the last frame given to addFrame (rectified pixels; a feature's
   // id is its landmark's id).
   [[nodiscard]] const std::vector<Feature>& lastFeatures() const;

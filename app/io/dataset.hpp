@@ -67,6 +67,8 @@ struct Dataset {
   // a run in the same frame can be evaluated without alignment.
   std::optional<fusion::Lla> groundtruth_enu_origin;
   std::vector<std::string> warnings;  // non-fatal defects found while reading (also logged)
+  // Kalibr's timeshift_cam_imu already added to every frame stamp (--calib), s.
+  double camera_timeshift_s = 0.0;
   std::shared_ptr<const ImageStore> image_store;  // set when frames carry no image paths
   std::vector<BagTopicUse> bag_topics;            // ROS bags only
 };

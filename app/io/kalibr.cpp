@@ -185,6 +185,7 @@ void applyKalibr(Dataset& ds, const KalibrCalibration& c) {
   if (shift_ns != 0) {
     for (FrameRecord& f : ds.frames) f.t_ns += shift_ns;  // into the IMU's clock
   }
+  ds.camera_timeshift_s = c.timeshift_cam_imu_s;
 }
 
 }  // namespace gvio::io

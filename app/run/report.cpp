@@ -30,6 +30,18 @@ json evaluationJson(const EvaluationOutcome& outcome) {
           {"path_length_m", e.path_length_m}};
 }
 
+// t_d: how much image stamps lag the exposures, after the calibration's timeshift; the total lag
+// of the raw stamps is t_d - timeshift_cam_imu (Kalibr: t_imu = t_cam + timeshift).
+json timeOffsetJson(const io::Dataset& ds, const VioRunResult& run) {
+  json history = json::array();
+  for (const auto& [t_ns, t_d] : run.time_offset_history) history.push_back({seconds(t_ns), t_d});
+  return {{"estimated", run.time_offset_estimated},
+          {"calibration_timeshift_cam_imu_s", ds.camera_timeshift_s},
+          {"t_d_s", run.time_offset_s},
+          {"stamp_lag_s", run.time_offset_s - ds.camera_timeshift_s},
+          {"history", history}};
+}
+
 }  // namespace
 
 json datasetJson(const io::Dataset& ds) {
@@ -71,6 +83,7 @@ json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportCon
                          {"tracking", timingJson(run.timings.tracking_ms)},
                          {"estimator", timingJson(run.timings.estimator_ms)},
                          {"total", timingJson(run.timings.total_ms)}};
+  report["time_offset"] = timeOffsetJson(ds, run);
   report["wall_s"] = run.wall_s;
   report["peak_rss_mb"] = ctx.peak_rss_mb;
   if (!ctx.map.is_null()) report["map"] = ctx.map;

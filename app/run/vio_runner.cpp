@@ -166,6 +166,7 @@ VioRunResult runVio(const io::Dataset& ds, odometry::EstimatorConfig config,
   r.baseline_m = rectifier.baselineM();
   config.tracker.stereo = stereo;
   odometry::VioEstimator estimator(config, rectifier.left(), rectifier.right());
+  r.time_offset_estimated = config.estimate_time_offset && odometry::usesImu(config.mode);
 
   // Decoding runs ahead by a few frames; the keyframe hook runs behind by a few keyframes (both
   // queues bound the images held). The estimator's inputs and the hook's order are those of the
@@ -220,6 +221,11 @@ VioRunResult runVio(const io::Dataset& ds, odometry::EstimatorConfig config,
                                  result.ms_estimator);
     appendEvents(estimator, r.events);
     if (!result.initialized) continue;
+    if (r.time_offset_estimated &&
+        (r.time_offset_history.empty() ||
+         frame.t_ns - r.time_offset_history.back().first >= 1'000'000'000)) {
+      r.time_offset_history.emplace_back(frame.t_ns, estimator.timeOffsetS());
+    }
     // Never write NaN; a stamp that does not increase would break TUM readers' association.
     if (!result.T_w_b.matrix().allFinite()) {
       ++r.nonfinite_poses;
@@ -242,6 +248,7 @@ VioRunResult runVio(const io::Dataset& ds, odometry::EstimatorConfig config,
                  r.nonfinite_poses);
   }
   r.counters = estimator.counters();
+  r.time_offset_s = estimator.timeOffsetS();
   r.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
   return r;
 }

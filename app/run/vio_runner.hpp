@@ -41,6 +41,11 @@ struct VioRunResult {
   int nonfinite_poses = 0;            // initialised frames whose pose was not finite (not written)
   std::size_t imu_samples = 0, gnss_fixes = 0;
   std::vector<odometry::VioEvent> events;
+  // The camera-IMU time offset estimate (vio.estimate_time_offset with an IMU): its value at the
+  // end and once per second of the drive (frame stamp, estimate), both in seconds.
+  bool time_offset_estimated = false;
+  double time_offset_s = 0.0;
+  std::vector<std::pair<std::int64_t, double>> time_offset_history;
   FrameTimings timings;
   double wall_s = 0.0;
 };

@@ -37,6 +37,8 @@ void SimConfig::validate() const {
   require(exposure_time_s > 0.0 && exposure_time_s < 1.0 / camera_rate_hz, "exposure_time_s",
           "positive and shorter than a frame", exposure_time_s);
   require(blur_samples >= 2 && blur_samples <= 32, "blur_samples", "in [2, 32]", blur_samples);
+  require(std::isfinite(camera_time_offset_s) && std::abs(camera_time_offset_s) < 1.0,
+          "camera_time_offset_s", "within (-1, 1) s", camera_time_offset_s);
   require(knot_spacing_s >= 0.05 && knot_spacing_s <= 5.0, "knot_spacing_s", "in [0.05, 5]",
           knot_spacing_s);
   require(smoothing >= 0.0 && std::isfinite(smoothing), "smoothing", "finite and >= 0", smoothing);

@@ -26,7 +26,10 @@ struct SimConfig {
   bool motion_blur = false;
   double exposure_time_s = 0.004;  // blur integrates over this interval
   int blur_samples = 4;            // renders averaged per blurred frame
-  double knot_spacing_s = 0.25;    // trajectory spline
+  // Camera stamps = exposure time + this (a camera clock the IMU's is off from; issue 16's
+  // time-offset test): images are rendered at the exposure, written with the shifted stamp.
+  double camera_time_offset_s = 0.0;
+  double knot_spacing_s = 0.25;  // trajectory spline
   double smoothing = 1e-2;
   int texture_size_px = 512;
   std::string world_style = "street";  // sim/world.hpp: WorldStyle (--world-style overrides)

@@ -277,15 +277,20 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
   std::vector<std::int64_t> frame_t;
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / config.camera_rate_hz));
   for (std::int64_t t = traj.t0_ns(); t <= t1; t += period_ns) frame_t.push_back(t);
+  // What the camera stamps each exposure with (its clock off by camera_time_offset_s).
+  const auto camera_offset_ns =
+      static_cast<std::int64_t>(std::llround(config.camera_time_offset_s * 1e9));
+  std::vector<std::int64_t> stamp_t = frame_t;
+  for (std::int64_t& t : stamp_t) t += camera_offset_ns;
   for (std::size_t k = 0; k < frame_t.size(); ++k) {
     for (std::size_t c = 0; c < T_b_c.size(); ++c) {
       const cv::Mat image = cameras.render(traj, frame_t[k], c, k);
       if (bag) {
-        bag->writeImage(frame_t[k], c, image);
+        bag->writeImage(stamp_t[k], c, image);
         continue;
       }
       const fs::path file =
-          kitti ? kittiImagePath(r.out, ids[c], k) : eurocImagePath(r.out, ids[c], frame_t[k]);
+          kitti ? kittiImagePath(r.out, ids[c], k) : eurocImagePath(r.out, ids[c], stamp_t[k]);
       fs::create_directories(file.parent_path());
       io::writePng(file, image);
     }
@@ -295,7 +300,7 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
 
   // Sensor logs and truth.
   if (kitti) {
-    for (const int id : ids) writeKittiImageStamps(r.out, id, frame_t);
+    for (const int id : ids) writeKittiImageStamps(r.out, id, stamp_t);
     writeKittiOxts(r.out, imu, traj, enu);
     fs::create_directories(r.out / "gnss");
     io::writeTextAtomic(r.out / "gnss" / "fixes.nmea", toNmeaLog(fixes));
@@ -306,7 +311,7 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
     bag->finish(imu, fixes, models, summary.imu_noise.noise, config.imu_rate_hz);
   } else {
     for (std::size_t c = 0; c < ids.size(); ++c)
-      writeEurocCamera(r.out, ids[c], frame_t, K, T_b_c[c], config.camera_rate_hz);
+      writeEurocCamera(r.out, ids[c], stamp_t, K, T_b_c[c], config.camera_rate_hz);
     writeEurocImu(r.out, imu, summary.imu_noise.noise, config.imu_rate_hz);
     writeEurocGnss(r.out, fixes);
     writeEurocTruth(r.out, imu, traj);

@@ -1,0 +1,65 @@
+// Reading a camera image out of a ROS bag: one 1241x376 mono8 sensor_msgs/Image (KITTI's size),
+// message read, chunk decompressed (none, lz4, bz2) and turned into the tracker's cv::Mat, in
+// the order a run reads frames. Target (issue 16): <= 2 ms per image.
+#include <benchmark/benchmark.h>
+
+#include <opencv2/core.hpp>
+#include <random>
+
+#include "io/dataset.hpp"
+#include "io/ros_image.hpp"
+#include "io/rosbag/bag_file.hpp"
+#include "support/fixtures.hpp"
+
+namespace gvio::io {
+namespace {
+
+constexpr int kImages = 40;
+
+// Camera-like content: smooth structure plus sensor noise (noise alone would not compress at
+// all, a flat image far too well).
+cv::Mat cameraLike(int k, std::mt19937& rng) {
+  cv::Mat image(376, 1241, CV_8UC1);
+  std::normal_distribution<double> noise(0.0, 2.0);
+  for (int r = 0; r < image.rows; ++r) {
+    auto* row = image.ptr<std::uint8_t>(r);
+    for (int c = 0; c < image.cols; ++c) {
+      const double v = 128 + 60 * std::sin(0.05 * (c + 7 * k)) * std::cos(0.07 * r) + noise(rng);
+      row[c] = cv::saturate_cast<std::uint8_t>(v);
+    }
+  }
+  return image;
+}
+
+void BM_BagImageRead(benchmark::State& state) {
+  const auto compression = static_cast<bag::Compression>(state.range(0));
+  test::TempDir dir("rosbag_bench");
+  const auto file = dir.path() / "images.bag";
+  {
+    std::mt19937 rng(1);
+    bag::BagWriter writer(file.string(), compression);
+    for (int k = 0; k < kImages; ++k) {
+      bag::ImageMessage m = grayToRosImage(cameraLike(k, rng), false);
+      const std::int64_t t_ns = 1'000'000'000 + k * 100'000'000LL;
+      m.t = {t_ns, t_ns};
+      writer.write("/cam0/image_raw", m);
+    }
+    writer.close();
+  }
+  Dataset ds = readDataset(file, DatasetFormat::kRosbag, ReaderConfig{});
+  ds.cameras[0].fx = ds.cameras[0].fy = 700.0;  // the size check needs no more
+  std::size_t frame = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(loadFrameImage(ds, frame, 0).data);
+    frame = (frame + 1) % ds.frames.size();
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_BagImageRead)
+    ->Arg(static_cast<int>(bag::Compression::kNone))
+    ->Arg(static_cast<int>(bag::Compression::kLz4))
+    ->Arg(static_cast<int>(bag::Compression::kBz2))
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace gvio::io
