@@ -38,15 +38,45 @@ struct GnssFix {
   double course_deg = std::numeric_limits<double>::quiet_NaN();
 };
 
-// Pinhole camera with radial-tangential (OpenCV plumb_bob) distortion and its pose in the body.
+// How a raw camera's lens bends rays away from the pinhole projection (x = X/Z, y = Y/Z, r = |x
+// y|).
+enum class Distortion {
+  // Radial-tangential (OpenCV plumb_bob, Kalibr radtan): coefficients k1 k2 p1 p2 [k3]. No
+  // coefficients, or all of them 0, is the undistorted pinhole camera.
+  kRadtan,
+  // Equidistant fisheye (Kannala & Brandt 2006, OpenCV cv::fisheye, Kalibr equidistant): the
+  // image radius grows with the ray's angle theta = atan(r), not with r: r_d = theta (1 + k1
+  // theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8). Exactly 4 coefficients; all 0 is still a
+  // fisheye (r_d = theta), not a pinhole.
+  kEquidistant,
+};
+
+// "radtan" or "equidistant", as Kalibr names them.
+inline std::string toString(Distortion d) {
+  return d == Distortion::kEquidistant ? "equidistant" : "radtan";
+}
+
+// Pinhole camera with lens distortion (see Distortion) and its pose in the body.
 struct CameraModel {
   std::string name;
   int width_px = 0;
   int height_px = 0;
   double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
-  std::vector<double> distortion;  // k1 k2 p1 p2 [k3], empty when rectified
+  // How `distortion` is read. Rectified cameras are radtan with no coefficients (a pinhole).
+  Distortion distortion_model = Distortion::kRadtan;
+  std::vector<double> distortion;  // radtan: k1 k2 p1 p2 [k3]; equidistant: k1 k2 k3 k4
   Eigen::Isometry3d T_b_c = Eigen::Isometry3d::Identity();
 };
+
+// False for a pinhole camera (radtan with no coefficient other than 0). An equidistant camera
+// always distorts: with k1..k4 = 0 it still images the ray's angle, not its tangent.
+inline bool hasLensDistortion(const CameraModel& cam) {
+  if (cam.distortion_model == Distortion::kEquidistant) return true;
+  for (const double d : cam.distortion) {
+    if (d != 0.0) return true;
+  }
+  return false;
+}
 
 // Noise densities of an IMU (continuous time), as Kalibr/EuRoC sensor.yaml state them.
 // Defaults: a typical automotive MEMS IMU (accelerometer ~200 ug/sqrt(Hz), gyro ~0.01

@@ -3,12 +3,12 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include <algorithm>
 #include <cmath>
 #include <string>
 
 #include "odometry/error.hpp"
 #include "odometry/lie.hpp"
+#include "odometry/rectifier_fisheye.hpp"
 
 namespace gvio::odometry {
 namespace {
@@ -24,7 +24,14 @@ void validateCamera(const CameraModel& cam) {
     throw InvalidInput(nameOf(cam) + ": image size and focal lengths must be positive and finite");
   }
   const std::size_t n = cam.distortion.size();
-  if (n != 0 && n != 4 && n != 5) {
+  if (cam.distortion_model == Distortion::kEquidistant) {
+    if (n != 4) {
+      throw InvalidInput(nameOf(cam) +
+                         ": the equidistant (fisheye) model takes exactly 4 distortion "
+                         "coefficients (k1 k2 k3 k4), got " +
+                         std::to_string(n));
+    }
+  } else if (n != 0 && n != 4 && n != 5) {
     throw InvalidInput(nameOf(cam) + ": expected 0, 4 or 5 distortion coefficients (k1 k2 p1 p2 " +
                        "[k3]), got " + std::to_string(n));
   }
@@ -33,9 +40,8 @@ void validateCamera(const CameraModel& cam) {
   }
 }
 
-bool hasDistortion(const CameraModel& cam) {
-  return std::any_of(cam.distortion.begin(), cam.distortion.end(),
-                     [](double d) { return d != 0.0; });
+bool isFisheye(const CameraModel& cam) {
+  return cam.distortion_model == Distortion::kEquidistant;
 }
 
 cv::Mat intrinsics(const CameraModel& cam) {
@@ -67,15 +73,36 @@ CameraModel rectifiedModel(const CameraModel& raw, const cv::Mat& K_new,
   cam.fy = K_new.at<double>(1, 1);
   cam.cx = K_new.at<double>(0, 2);
   cam.cy = K_new.at<double>(1, 2);
+  cam.distortion_model = Distortion::kRadtan;  // with no coefficients: a pinhole
   cam.distortion.clear();
   cam.T_b_c.linear() = normalizeRotation(raw.T_b_c.linear() * R_rect_raw.transpose());
   return cam;
+}
+
+// Maps from the rectified camera (K_new, turned by R_rect: x_rect = R_rect x_raw; empty for none)
+// into the raw image, through the raw camera's own distortion model.
+void undistortRectifyMap(const CameraModel& raw, const cv::Mat& R_rect, const cv::Mat& K_new,
+                         cv::Mat& map_xy, cv::Mat& map_frac) {
+  const cv::Size size(raw.width_px, raw.height_px);
+  if (isFisheye(raw)) {
+    cv::fisheye::initUndistortRectifyMap(intrinsics(raw), distortionOf(raw), R_rect, K_new, size,
+                                         CV_16SC2, map_xy, map_frac);
+  } else {
+    cv::initUndistortRectifyMap(intrinsics(raw), distortionOf(raw), R_rect, K_new, size, CV_16SC2,
+                                map_xy, map_frac);
+  }
 }
 
 // The camera as given, minus its (zero) distortion, with an exact rotation: calibration files
 // print rotations to 6-7 digits, and the estimator inverts T_b_c as a rigid transform.
 CameraModel passThrough(const CameraModel& raw) {
   return rectifiedModel(raw, intrinsics(raw), Eigen::Matrix3d::Identity());
+}
+
+InvalidInput notSideBySide(const CameraModel& raw_left, const CameraModel& raw_right) {
+  return InvalidInput("stereo: cameras " + raw_left.name + " and " + raw_right.name +
+                      " cannot be rectified side by side (the right camera must lie to the right "
+                      "of the left one, mostly along its x axis)");
 }
 
 // Right camera = left camera moved by +baseline along its own x axis: the estimator's contract,
@@ -97,6 +124,14 @@ Rectifier::Rectifier(const CameraModel& left, const std::optional<CameraModel>& 
     return;
   }
   validateCamera(*right);
+  if (right->distortion_model != left.distortion_model) {
+    // One rectification needs both cameras undistorted through one model; a radtan camera is no
+    // equidistant one with some coefficients (nor the other way round).
+    throw InvalidInput("stereo: " + nameOf(left) + " is " + toString(left.distortion_model) +
+                       " and " + nameOf(*right) + " " + toString(right->distortion_model) +
+                       ": cameras of different distortion models cannot be rectified together "
+                       "(calibrate both with one model)");
+  }
   if (right->width_px != left.width_px || right->height_px != left.height_px) {
     throw InvalidInput("stereo cameras of different image sizes (" + std::to_string(left.width_px) +
                        "x" + std::to_string(left.height_px) + " and " +
@@ -107,16 +142,18 @@ Rectifier::Rectifier(const CameraModel& left, const std::optional<CameraModel>& 
 }
 
 void Rectifier::initMono(const CameraModel& raw) {
-  if (!hasDistortion(raw)) {
+  if (!hasLensDistortion(raw)) {
     identity_ = true;
     left_ = passThrough(raw);
     return;
   }
   const cv::Size size(raw.width_px, raw.height_px);
   const cv::Mat K = intrinsics(raw), D = distortionOf(raw);
-  // alpha 0: every rectified pixel sees the scene (no black border for the tracker to find).
-  const cv::Mat K_new = cv::getOptimalNewCameraMatrix(K, D, size, 0.0, size);
-  cv::initUndistortRectifyMap(K, D, cv::Mat(), K_new, size, CV_16SC2, map_left_xy_, map_left_frac_);
+  // alpha (balance) 0: every rectified pixel sees the scene (no black border for the tracker to
+  // find; a wide fisheye's corners see more than any pinhole image could hold anyway).
+  const cv::Mat K_new = isFisheye(raw) ? fisheye::monoIntrinsics(K, D, size)
+                                       : cv::getOptimalNewCameraMatrix(K, D, size, 0.0, size);
+  undistortRectifyMap(raw, cv::Mat(), K_new, map_left_xy_, map_left_frac_);
   left_ = rectifiedModel(raw, K_new, Eigen::Matrix3d::Identity());
 }
 
@@ -133,7 +170,7 @@ void Rectifier::initStereo(const CameraModel& raw_left, const CameraModel& raw_r
                                std::abs(raw_left.fy - raw_right.fy) <= kIdentityTolerance &&
                                std::abs(raw_left.cx - raw_right.cx) <= kIdentityTolerance &&
                                std::abs(raw_left.cy - raw_right.cy) <= kIdentityTolerance;
-  if (!hasDistortion(raw_left) && !hasDistortion(raw_right) && same_intrinsics &&
+  if (!hasLensDistortion(raw_left) && !hasLensDistortion(raw_right) && same_intrinsics &&
       (raw_right.T_b_c.linear() - R_b_cl).cwiseAbs().maxCoeff() <= kIdentityTolerance &&
       (d_b - along_x_m * x_b_cl).norm() <= kIdentityTolerance) {
     if (along_x_m <= 0.0) {
@@ -160,12 +197,28 @@ void Rectifier::initStereo(const CameraModel& raw_left, const CameraModel& raw_r
     for (int c = 0; c < 3; ++c) R.at<double>(r, c) = T_cr_cl.linear()(r, c);
     T.at<double>(r, 0) = T_cr_cl.translation()(r);
   }
-  cv::Mat R_l, R_r, P_l, P_r, Q;
+  cv::Mat R_l, R_r, K_new;
   // Zero disparity: both rectified cameras share one principal point (the estimator's contract);
-  // alpha 0: no invalid (black) pixels in either rectified image.
-  cv::stereoRectify(K_l, D_l, K_r, D_r, size, R, T, R_l, R_r, P_l, P_r, Q, cv::CALIB_ZERO_DISPARITY,
-                    0.0, size);
-  const cv::Mat K_new = P_l.colRange(0, 3).clone();
+  // alpha (balance) 0: no invalid (black) pixels in either rectified image.
+  if (isFisheye(raw_left)) {
+    // cv::fisheye::stereoRectify always turns the baseline onto x, even a vertical one; refuse
+    // what cv::stereoRectify would rectify vertically: |t_y| >= |t_x| once each camera is turned
+    // by half the relative rotation.
+    const Eigen::AngleAxisd aa_cr_cl(T_cr_cl.linear());
+    const Eigen::Vector3d t_half =
+        Eigen::AngleAxisd(-0.5 * aa_cr_cl.angle(), aa_cr_cl.axis()) * T_cr_cl.translation();
+    if (std::abs(t_half.y()) >= std::abs(t_half.x())) throw notSideBySide(raw_left, raw_right);
+    const fisheye::StereoRectification rect =
+        fisheye::stereoRectification(K_l, D_l, K_r, D_r, size, R, T);
+    R_l = rect.R_left;
+    R_r = rect.R_right;
+    K_new = rect.K_new;
+  } else {
+    cv::Mat P_l, P_r, Q;
+    cv::stereoRectify(K_l, D_l, K_r, D_r, size, R, T, R_l, R_r, P_l, P_r, Q,
+                      cv::CALIB_ZERO_DISPARITY, 0.0, size);
+    K_new = P_l.colRange(0, 3).clone();
+  }
   const Eigen::Matrix3d R_rl_l = toEigen(R_l);
   // The right camera centre seen from the rectified left camera: (baseline, 0, 0) for a
   // horizontal rig; stereoRectify rectifies vertically when the offset is mostly along y.
@@ -173,13 +226,10 @@ void Rectifier::initStereo(const CameraModel& raw_left, const CameraModel& raw_r
   if (!cv::checkRange(K_new) || p_rl_cr.x() <= 0.0 ||
       std::abs(p_rl_cr.y()) > 1e-6 * p_rl_cr.norm() ||
       std::abs(p_rl_cr.z()) > 1e-6 * p_rl_cr.norm()) {
-    throw InvalidInput(
-        "stereo: cameras " + raw_left.name + " and " + raw_right.name +
-        " cannot be rectified side by side (the right camera must lie to the right of the "
-        "left one, mostly along its x axis)");
+    throw notSideBySide(raw_left, raw_right);
   }
-  cv::initUndistortRectifyMap(K_l, D_l, R_l, K_new, size, CV_16SC2, map_left_xy_, map_left_frac_);
-  cv::initUndistortRectifyMap(K_r, D_r, R_r, K_new, size, CV_16SC2, map_right_xy_, map_right_frac_);
+  undistortRectifyMap(raw_left, R_l, K_new, map_left_xy_, map_left_frac_);
+  undistortRectifyMap(raw_right, R_r, K_new, map_right_xy_, map_right_frac_);
   baseline_m_ = p_rl_cr.x();
   left_ = rectifiedModel(raw_left, K_new, R_rl_l);
   right_ = rightOf(left_, raw_right, baseline_m_);

@@ -1,10 +1,14 @@
 #pragma once
 // Turns raw calibrated cameras into the rectified pinhole cameras the estimator expects (no
 // distortion; for stereo one shared K and the right camera offset only along the left x axis), and
-// resamples images accordingly. Stereo: cv::stereoRectify (alpha 0, CALIB_ZERO_DISPARITY); mono:
-// cv::getOptimalNewCameraMatrix (alpha 0). Cameras that already are rectified (KITTI's rectified
-// grey pair, the simulator's output) pass through untouched: remapping costs time and blurs.
-// Pure image geometry: no file I/O.
+// resamples images accordingly. Radtan cameras: cv::stereoRectify (alpha 0, CALIB_ZERO_DISPARITY)
+// for stereo, cv::getOptimalNewCameraMatrix (alpha 0) for mono. Equidistant (fisheye,
+// Kannala-Brandt 2006) cameras through OpenCV's fisheye module: cv::fisheye::stereoRectify (balance
+// 0, CALIB_ZERO_DISPARITY) for stereo, cv::fisheye::estimateNewCameraMatrixForUndistortRectify
+// (balance 0) for mono, each zoomed in (fov_scale) just enough that no rectified pixel samples
+// outside the raw image (odometry/rectifier_fisheye.hpp); a stereo pair must share one model.
+// Cameras that already are rectified (KITTI's rectified grey pair, the simulator's output) pass
+// through untouched: remapping costs time and blurs. Pure image geometry: no file I/O.
 #include <optional>
 
 #include <opencv2/core/mat.hpp>
@@ -25,9 +29,10 @@ class Rectifier {
   static constexpr double kIdentityTolerance = 1e-9;
 
   // `left` always, `right` for a stereo rig. Throws InvalidInput for an invalid camera (size or
-  // focal length not positive, distortion not 0, 4 or 5 coefficients), stereo cameras of
-  // different sizes, and rigs that cannot be rectified side by side (the right camera must lie to
-  // the right of the left one, mostly along its x axis).
+  // focal length not positive; radtan distortion not 0, 4 or 5 coefficients, equidistant not
+  // exactly 4), stereo cameras of different sizes or different distortion models, and rigs that
+  // cannot be rectified side by side (the right camera must lie to the right of the left one,
+  // mostly along its x axis).
   explicit Rectifier(const CameraModel& left,
                      const std::optional<CameraModel>& right = std::nullopt);
 

@@ -37,11 +37,9 @@ void requireRectified(const CameraModel& cam) {
   if (!(cam.fx > 0 && cam.fy > 0 && cam.width_px > 0 && cam.height_px > 0)) {
     throw InvalidInput("vio: camera '" + cam.name + "' has invalid intrinsics or size");
   }
-  for (double d : cam.distortion) {
-    if (d != 0.0) {
-      throw InvalidInput("vio: camera '" + cam.name +
-                         "' has lens distortion; the estimator needs rectified cameras");
-    }
+  if (hasLensDistortion(cam)) {  // equidistant cameras included, whatever their coefficients
+    throw InvalidInput("vio: camera '" + cam.name +
+                       "' has lens distortion; the estimator needs rectified cameras");
   }
 }
 

@@ -58,6 +58,7 @@ json cameraJson(const CameraModel& cam) {
           {"fy", cam.fy},
           {"cx", cam.cx},
           {"cy", cam.cy},
+          {"distortion_model", hasLensDistortion(cam) ? toString(cam.distortion_model) : "none"},
           {"distortion", cam.distortion},
           {"p_b_c_m",
            {cam.T_b_c.translation().x(), cam.T_b_c.translation().y(), cam.T_b_c.translation().z()}},
@@ -201,11 +202,14 @@ std::string formatSummary(const json& j) {
   stream("cameras", "frames");
   if (j.contains("cameras")) {
     for (const auto& m : j["cameras"]["models"]) {
+      const std::string distortion = m["distortion_model"].get<std::string>();
       out += fmt::format(
-          "  {:<8} {}x{} fx {:.3f} fy {:.3f} cx {:.3f} cy {:.3f}, p_b_c [{:.3f} {:.3f} {:.3f}] m\n",
+          "  {:<8} {}x{} fx {:.3f} fy {:.3f} cx {:.3f} cy {:.3f}{}, p_b_c [{:.3f} {:.3f} {:.3f}] "
+          "m\n",
           m["name"].get<std::string>(), m["width"].get<int>(), m["height"].get<int>(),
           m["fx"].get<double>(), m["fy"].get<double>(), m["cx"].get<double>(),
-          m["cy"].get<double>(), m["p_b_c_m"][0].get<double>(), m["p_b_c_m"][1].get<double>(),
+          m["cy"].get<double>(), distortion == "none" ? "" : ", " + distortion + " distortion",
+          m["p_b_c_m"][0].get<double>(), m["p_b_c_m"][1].get<double>(),
           m["p_b_c_m"][2].get<double>());
     }
     if (j["cameras"].contains("stereo_baseline_m")) {

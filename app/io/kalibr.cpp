@@ -66,19 +66,22 @@ Eigen::Isometry3d readCamera(const YAML::Node& block, const std::string& name,
         file, lineOf(block["camera_model"]),
         fmt::format("{}: camera_model '{}' is not supported (pinhole only)", name, model));
   }
-  if (distortion == "equidistant" || distortion == "fov") {
+  if (distortion == "fov") {
     throw InputError(file, lineOf(block["distortion_model"]),
-                     fmt::format("{}: distortion_model '{}' is not supported yet (radtan only): "
-                                 "fisheye rectification is not built",
-                                 name, distortion));
+                     fmt::format("{}: distortion_model 'fov' is not supported yet (radtan and "
+                                 "equidistant only): FOV-model rectification is not built",
+                                 name));
   }
-  if (distortion != "radtan" && distortion != "none") {
+  if (distortion != "radtan" && distortion != "equidistant" && distortion != "none") {
     throw InputError(file, lineOf(block["distortion_model"]),
                      fmt::format("{}: unknown distortion_model '{}'", name, distortion));
   }
   CameraModel cam = pinholeCamera(block, name, file);
-  if (distortion == "radtan")
+  if (distortion != "none") {
+    // radtan: k1 k2 p1 p2; equidistant: Kannala-Brandt k1 k2 k3 k4, cv::fisheye's order too.
     cam.distortion = yamlList<double>(block, "distortion_coeffs", 4, file);
+  }
+  if (distortion == "equidistant") cam.distortion_model = Distortion::kEquidistant;
   Eigen::Isometry3d T_cam_imu;
   if (block["T_cam_imu"]) {
     T_cam_imu = transform4x4(block, "T_cam_imu", file);

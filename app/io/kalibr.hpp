@@ -1,10 +1,11 @@
 #pragma once
 // Calibration from Kalibr's output files, for any dataset format (gvio run / inspect --calib):
 //  - camchain.yaml: cam0, cam1, ... each with camera_model (pinhole), intrinsics [fu fv pu pv],
-//    distortion_model (radtan; equidistant is refused for now, with that reason),
-//    distortion_coeffs, resolution [w h], T_cam_imu (4x4, IMU -> camera), T_cn_cnm1 (camera n
-//    relative to n-1; used when T_cam_imu is absent, checked against it when both are there),
-//    timeshift_cam_imu (t_imu = t_cam + shift);
+//    distortion_model (radtan [k1 k2 p1 p2], equidistant [k1 k2 k3 k4]: fisheye, rectified with
+//    cv::fisheye, or none; fov is refused for now, with that reason), distortion_coeffs,
+//    resolution [w h], T_cam_imu (4x4, IMU -> camera), T_cn_cnm1 (camera n relative to n-1; used
+//    when T_cam_imu is absent, checked against it when both are there), timeshift_cam_imu
+//    (t_imu = t_cam + shift);
 //  - imu.yaml: accelerometer/gyroscope noise densities and random walks, at the top level (Kalibr's
 //    input) or under imu0 (its output).
 // The body frame is the IMU's, as everywhere in gvio: T_b_c = T_cam_imu^-1. Errors name the file

@@ -1,5 +1,7 @@
 #include "run/report.hpp"
 
+#include <algorithm>
+
 #include "io/dataset_summary.hpp"
 #include "run/stats.hpp"
 
@@ -66,8 +68,15 @@ json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportCon
   report["mode"] = odometry::toString(run.mode);
   report["imu_noise_source"] =
       ctx.imu_noise_source.empty() ? json(nullptr) : json(ctx.imu_noise_source);
+  // The lens model the rectifier undistorted (a stereo pair shares one); "none" for pinholes.
+  std::string distortion = "none";
+  const std::size_t used = odometry::usesStereo(run.mode) ? 2 : 1;
+  for (std::size_t i = 0; i < std::min(used, ds.cameras.size()); ++i) {
+    if (hasLensDistortion(ds.cameras[i])) distortion = toString(ds.cameras[i].distortion_model);
+  }
   report["rectification"] = {{"identity", run.rectification_identity},
-                             {"baseline_m", run.baseline_m}};
+                             {"baseline_m", run.baseline_m},
+                             {"distortion_model", distortion}};
   const odometry::VioCounters& c = run.counters;
   report["counts"] = {{"frames", c.frames},
                       {"keyframes", c.keyframes},

@@ -17,6 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::quoted;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // `gvio inspect --dataset <dataset> --no-progress <extra>`.
 test::CommandResult inspect(const fs::path& dataset, const std::string& extra = "") {
@@ -71,6 +72,8 @@ TEST_F(CliInspectTest, SummarisesValidDriveAsTextAndJson) {
   EXPECT_EQ(j["gnss"]["count"], 60);
   EXPECT_NEAR(j["cameras"]["stereo_baseline_m"].get<double>(), 0.537, 1e-6);
   EXPECT_EQ(j["cameras"]["models"][0]["width"], 64);
+  EXPECT_EQ(j["cameras"]["models"][0]["distortion_model"], "none");  // D_00: 0 0 0 0 0
+  EXPECT_THAT(r.out, Not(HasSubstr("distortion")));
   EXPECT_TRUE(j["warnings"].empty());
 }
 

@@ -1,18 +1,26 @@
-// Kalibr calibration files (issue 16): camchain.yaml and imu.yaml into the dataset's cameras, IMU
-// noise and camera clock; bad files named with their line; gvio run --calib on a simulated drive.
+// Kalibr calibration files (issue 16): camchain.yaml (radtan and equidistant cameras) and imu.yaml
+// into the dataset's cameras, IMU noise and camera clock; bad files named with their line; gvio run
+// --calib on a simulated drive, as taken and as seen through a fisheye lens.
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "io/dataset.hpp"
 #include "io/input_error.hpp"
 #include "io/kalibr.hpp"
+#include "odometry/rectifier.hpp"
 #include "support/euroc_camera.hpp"
 #include "support/fixtures.hpp"
+#include "support/tumvi_camera.hpp"
 
 namespace gvio::io {
 namespace {
@@ -64,6 +72,7 @@ TEST(Kalibr, CamchainAndImuFiles) {
   EXPECT_DOUBLE_EQ(k.cameras[0].fx, 458.654);
   EXPECT_EQ(k.cameras[0].width_px, 752);
   EXPECT_EQ(k.cameras[0].distortion, c0.distortion);
+  EXPECT_EQ(k.cameras[0].distortion_model, Distortion::kRadtan);
   EXPECT_TRUE(k.cameras[1].T_b_c.isApprox(c1.T_b_c, 1e-12));
   EXPECT_DOUBLE_EQ(k.timeshift_cam_imu_s, 0.0125);
   ASSERT_TRUE(k.imu_noise.has_value());
@@ -100,6 +109,35 @@ TEST(Kalibr, CamchainAndImuFiles) {
   EXPECT_THROW(applyKalibr(ds, k), InvalidInput);  // two calibrated cameras, one in the dataset
 }
 
+// TUM VI's fisheye chain (Kalibr's pinhole-equi): read as equidistant cameras, k1..k4 in order,
+// which the rectifier takes as they are.
+TEST(Kalibr, EquidistantCamchain) {
+  test::TempDir dir("kalibr_equi");
+  const CameraModel c0 = test::tumviCam0(), c1 = test::tumviCam1();
+  test::writeText(dir.path() / "camchain.yaml", cameraYaml("cam0", c0, 0.0, "equidistant") +
+                                                    cameraYaml("cam1", c1, 0.0, "equidistant"));
+  const KalibrCalibration k = readKalibr({dir.path() / "camchain.yaml"});
+  ASSERT_EQ(k.cameras.size(), 2U);
+  EXPECT_TRUE(k.warnings.empty()) << k.warnings.front();
+  for (std::size_t i = 0; i < 2; ++i) {
+    const CameraModel& expected = i == 0 ? c0 : c1;
+    EXPECT_EQ(k.cameras[i].distortion_model, Distortion::kEquidistant);
+    EXPECT_EQ(k.cameras[i].distortion, expected.distortion);
+    EXPECT_DOUBLE_EQ(k.cameras[i].fx, expected.fx);
+    EXPECT_EQ(k.cameras[i].width_px, 512);
+    EXPECT_TRUE(k.cameras[i].T_b_c.isApprox(expected.T_b_c, 1e-12));
+  }
+  const odometry::Rectifier rect(k.cameras[0], k.cameras[1]);
+  EXPECT_FALSE(rect.isIdentity());
+  EXPECT_NEAR(rect.baselineM(), 0.1011, 1e-3);
+
+  // distortion_model none: a pinhole, whatever distortion_coeffs say.
+  test::writeText(dir.path() / "none.yaml", cameraYaml("cam0", c0, 0.0, "none"));
+  const KalibrCalibration pinhole = readKalibr({dir.path() / "none.yaml"});
+  EXPECT_EQ(pinhole.cameras[0].distortion_model, Distortion::kRadtan);
+  EXPECT_TRUE(pinhole.cameras[0].distortion.empty());
+}
+
 std::string kalibrError(const std::string& text) {
   test::TempDir dir("kalibr_bad");
   const fs::path file = dir.path() / "camchain.yaml";
@@ -114,8 +152,13 @@ std::string kalibrError(const std::string& text) {
 
 TEST(Kalibr, BadFilesNameTheFileAndLine) {
   const CameraModel c0 = test::eurocCam0();
-  EXPECT_THAT(kalibrError(cameraYaml("cam0", c0, 0.0, "equidistant")),
-              AllOf(HasSubstr("camchain.yaml:9"), HasSubstr("'equidistant' is not supported yet")));
+  EXPECT_THAT(kalibrError(cameraYaml("cam0", c0, 0.0, "fov")),
+              AllOf(HasSubstr("camchain.yaml:9"), HasSubstr("cam0: distortion_model 'fov' is not "
+                                                            "supported yet")));
+  std::string five = cameraYaml("cam0", test::tumviCam0(), 0.0, "equidistant");
+  five.replace(five.find("distortion_coeffs: ["), 20, "distortion_coeffs: [0.001, ");
+  EXPECT_THAT(kalibrError(five), AllOf(HasSubstr("camchain.yaml:8"),
+                                       HasSubstr("'distortion_coeffs' must be a list of 4")));
   EXPECT_THAT(kalibrError(cameraYaml("cam0", c0, 0.0, "banana")), HasSubstr("unknown distortion"));
   std::string no_t = cameraYaml("cam0", c0, 0.0);
   no_t.erase(no_t.find("  T_cam_imu"), no_t.find("  camera_model") - no_t.find("  T_cam_imu"));
@@ -139,8 +182,44 @@ TEST(Kalibr, BadFilesNameTheFileAndLine) {
   EXPECT_THAT(kalibrError("cam0: [unclosed\n"), HasSubstr("camchain.yaml:"));
 }
 
+// The drive's pinhole images as an equidistant lens would have taken them: each fisheye pixel takes
+// the pinhole image's value along its own ray (cv::fisheye::undistortPoints gives the ray).
+// Rewrites the images of cameras 0 and 1 in `copy`, a copy of the dataset.
+void seenThroughFisheye(const Dataset& ds, const fs::path& copy, const CameraModel& fisheye) {
+  const cv::Mat K =
+      (cv::Mat_<double>(3, 3) << fisheye.fx, 0, fisheye.cx, 0, fisheye.fy, fisheye.cy, 0, 0, 1);
+  std::vector<cv::Point2d> px, rays;
+  for (int v = 0; v < fisheye.height_px; ++v) {
+    for (int u = 0; u < fisheye.width_px; ++u) px.emplace_back(u, v);
+  }
+  cv::fisheye::undistortPoints(px, rays, K, fisheye.distortion);
+  std::vector<cv::Mat> map_x, map_y;
+  for (std::size_t c = 0; c < 2; ++c) {
+    const CameraModel& pinhole = ds.cameras[c];
+    map_x.emplace_back(fisheye.height_px, fisheye.width_px, CV_32F);
+    map_y.emplace_back(fisheye.height_px, fisheye.width_px, CV_32F);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      const int u = static_cast<int>(i) % fisheye.width_px,
+                v = static_cast<int>(i) / fisheye.width_px;
+      map_x[c].at<float>(v, u) = static_cast<float>(pinhole.fx * rays[i].x + pinhole.cx);
+      map_y[c].at<float>(v, u) = static_cast<float>(pinhole.fy * rays[i].y + pinhole.cy);
+    }
+  }
+  for (const FrameRecord& frame : ds.frames) {
+    for (std::size_t c = 0; c < 2; ++c) {
+      const fs::path file = copy / frame.image_paths.at(c).lexically_relative(ds.root);
+      const cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+      ASSERT_FALSE(image.empty()) << file;
+      cv::Mat out;
+      cv::remap(image, out, map_x[c], map_y[c], cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+      ASSERT_TRUE(cv::imwrite(file.string(), out)) << file;
+    }
+  }
+}
+
 // gvio run --calib with the simulated drive's own calibration written as Kalibr files gives the
-// same run as the dataset's calibration files; a fisheye chain exits 2 with one line.
+// same run as the dataset's calibration files; the drive's images seen through an equidistant lens,
+// with that lens as a Kalibr chain, run about as well; a fov chain exits 2 with one line.
 TEST(CliKalibr, TheDrivesOwnCalibrationAsKalibrFilesGivesTheSameRun) {
   const fs::path drive = test::cachedSimulation(
       fmt::format("--trajectory {}/assets/demo/drive.tum --seconds 20 --seed 9", GVIO_SOURCE_DIR));
@@ -149,31 +228,66 @@ TEST(CliKalibr, TheDrivesOwnCalibrationAsKalibrFilesGivesTheSameRun) {
   test::TempDir dir("cli_kalibr");
   test::writeText(dir.path() / "camchain.yaml",
                   cameraYaml("cam0", ds.cameras[0], 0.0) + cameraYaml("cam1", ds.cameras[1], 0.0));
-  const auto run = [&](const std::string& extra, const std::string& out) {
+  const auto run = [&](const std::string& extra, const std::string& out, const fs::path& dataset) {
     return test::runGvio(fmt::format(
         "run --dataset {} --out {} --no-progress --gnss off --set map.enabled=false --set "
         "loops.enabled=false {}",
-        test::quoted(drive), test::quoted(dir.path() / out), extra));
+        test::quoted(dataset), test::quoted(dir.path() / out), extra));
   };
-  const test::CommandResult own = run("", "own");
+  const test::CommandResult own = run("", "own", drive);
   ASSERT_EQ(own.exit_code, 0) << own.err;
   const test::CommandResult kalibr =
-      run("--calib " + test::quoted(dir.path() / "camchain.yaml"), "kalibr");
+      run("--calib " + test::quoted(dir.path() / "camchain.yaml"), "kalibr", drive);
   ASSERT_EQ(kalibr.exit_code, 0) << kalibr.err;
+  const auto report = [&](const std::string& out) {
+    return nlohmann::json::parse(test::readText(dir.path() / out / "report.json"));
+  };
   const auto ape = [&](const std::string& out) {
-    const auto j = nlohmann::json::parse(test::readText(dir.path() / out / "report.json"));
-    return j["evaluation"]["ape_se3"]["rmse"].get<double>();
+    return report(out)["evaluation"]["ape_se3"]["rmse"].get<double>();
   };
   EXPECT_NEAR(ape("kalibr"), ape("own"), 1e-3);
   EXPECT_LT(ape("kalibr"), 0.5);
+  EXPECT_EQ(report("kalibr")["rectification"]["distortion_model"], "none");
 
+  // A lens of ~84 deg across the diagonal whose image holds nothing the pinhole image does not:
+  // at its corners a pinhole model of the same focal length would be off by ~140 px.
+  CameraModel fisheye = ds.cameras[0];
+  fisheye.fx = fisheye.fy = 900.0;
+  fisheye.distortion_model = Distortion::kEquidistant;
+  fisheye.distortion = {0.02, -0.01, 0.005, -0.001};
+  const fs::path fisheye_drive = dir.path() / "fisheye_drive";
+  fs::copy(drive, fisheye_drive, fs::copy_options::recursive);
+  seenThroughFisheye(ds, fisheye_drive, fisheye);
+  CameraModel fisheye1 = fisheye;
+  fisheye1.T_b_c = ds.cameras[1].T_b_c;
   test::writeText(dir.path() / "fisheye.yaml",
-                  cameraYaml("cam0", ds.cameras[0], 0.0, "equidistant") +
-                      cameraYaml("cam1", ds.cameras[1], 0.0, "equidistant"));
+                  cameraYaml("cam0", fisheye, 0.0, "equidistant") +
+                      cameraYaml("cam1", fisheye1, 0.0, "equidistant"));
+  const test::CommandResult equi =
+      run("--calib " + test::quoted(dir.path() / "fisheye.yaml"), "fisheye", fisheye_drive);
+  ASSERT_EQ(equi.exit_code, 0) << equi.err;
+  EXPECT_EQ(report("fisheye")["rectification"]["identity"], false);
+  EXPECT_EQ(report("fisheye")["rectification"]["distortion_model"], "equidistant");
+  EXPECT_NEAR(report("fisheye")["rectification"]["baseline_m"].get<double>(), 0.537, 1e-6);
+  EXPECT_LT(ape("fisheye"), 0.5);
+  // gvio inspect names the model, in the text and the JSON.
+  const test::CommandResult summary = test::runGvio(
+      fmt::format("inspect --dataset {} --quick --no-progress --calib {} --json {}",
+                  test::quoted(fisheye_drive), test::quoted(dir.path() / "fisheye.yaml"),
+                  test::quoted(dir.path() / "summary.json")));
+  ASSERT_EQ(summary.exit_code, 0) << summary.err;
+  EXPECT_THAT(summary.out, HasSubstr("cy 185.216, equidistant distortion, p_b_c"));
+  const auto models =
+      nlohmann::json::parse(test::readText(dir.path() / "summary.json"))["cameras"]["models"];
+  EXPECT_EQ(models[1]["distortion_model"], "equidistant");
+  EXPECT_EQ(models[1]["distortion"].size(), 4U);
+
+  test::writeText(dir.path() / "fov.yaml", cameraYaml("cam0", ds.cameras[0], 0.0, "fov") +
+                                               cameraYaml("cam1", ds.cameras[1], 0.0, "fov"));
   const test::CommandResult bad =
-      run("--calib " + test::quoted(dir.path() / "fisheye.yaml"), "bad");
+      run("--calib " + test::quoted(dir.path() / "fov.yaml"), "bad", drive);
   EXPECT_EQ(bad.exit_code, 2);
-  EXPECT_THAT(bad.err, HasSubstr("fisheye.yaml:"));
+  EXPECT_THAT(bad.err, AllOf(HasSubstr("fov.yaml:"), HasSubstr("'fov' is not supported")));
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
 }
 

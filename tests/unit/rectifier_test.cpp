@@ -7,18 +7,20 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
-
-#include <random>
 
 #include "odometry/error.hpp"
 #include "support/euroc_camera.hpp"
+#include "support/rectification_check.hpp"
 
 namespace gvio::odometry {
 namespace {
 using test::eurocCam0;
 using test::eurocCam1;
+using test::projectPinhole;
+using test::rectifierError;
+using test::visiblePoints;
+using test::worstMapError;
 using testing::HasSubstr;
 
 // KITTI's rectified grey pair: no distortion, one K, cam1 0.537 m along cam0's x axis.
@@ -39,99 +41,6 @@ CameraModel kittiCam1() {
   c.name = "image_01";
   c.T_b_c = c.T_b_c * Eigen::Translation3d(0.537, 0.0, 0.0);
   return c;
-}
-
-Eigen::Vector2d projectPinhole(const CameraModel& cam, const Eigen::Vector3d& p_b) {
-  const Eigen::Vector3d p_c = cam.T_b_c.inverse() * p_b;
-  return {cam.fx * p_c.x() / p_c.z() + cam.cx, cam.fy * p_c.y() / p_c.z() + cam.cy};
-}
-
-// Through the original, distorted model, as OpenCV defines it.
-Eigen::Vector2d projectOriginal(const CameraModel& cam, const Eigen::Vector3d& p_b) {
-  const Eigen::Isometry3d T_c_b = cam.T_b_c.inverse();
-  cv::Mat R(3, 3, CV_64F), rvec, tvec(3, 1, CV_64F);
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) R.at<double>(r, c) = T_c_b.linear()(r, c);
-    tvec.at<double>(r) = T_c_b.translation()(r);
-  }
-  cv::Rodrigues(R, rvec);
-  const cv::Mat K = (cv::Mat_<double>(3, 3) << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
-  std::vector<cv::Point2d> px;
-  cv::projectPoints(std::vector<cv::Point3d>{{p_b.x(), p_b.y(), p_b.z()}}, rvec, tvec, K,
-                    cam.distortion, px);
-  return {px[0].x, px[0].y};
-}
-
-bool inside(const CameraModel& cam, const Eigen::Vector2d& px, double margin) {
-  return px.x() >= margin && px.y() >= margin && px.x() <= cam.width_px - 1 - margin &&
-         px.y() <= cam.height_px - 1 - margin;
-}
-
-// Points in front of the rectified left camera (2-30 m), seen inside every image (original and
-// rectified, left and right) with a 2 px margin.
-std::vector<Eigen::Vector3d> visiblePoints(const Rectifier& rect, const CameraModel& raw_left,
-                                           const std::optional<CameraModel>& raw_right) {
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  const CameraModel& left = rect.left();
-  std::vector<Eigen::Vector3d> points;
-  while (points.size() < 300) {
-    const double depth = 2.0 + 28.0 * u(rng);
-    const Eigen::Vector3d p_c((left.width_px * u(rng) - left.cx) / left.fx * depth,
-                              (left.height_px * u(rng) - left.cy) / left.fy * depth, depth);
-    const Eigen::Vector3d p_b = left.T_b_c * p_c;
-    bool ok = inside(left, projectPinhole(left, p_b), 2) &&
-              inside(raw_left, projectOriginal(raw_left, p_b), 2);
-    if (raw_right) {
-      ok = ok && inside(*rect.right(), projectPinhole(*rect.right(), p_b), 2) &&
-           inside(*raw_right, projectOriginal(*raw_right, p_b), 2);
-    }
-    if (ok) points.push_back(p_b);
-  }
-  return points;
-}
-
-// An image whose pixels hold their own x (or y) coordinate: after rectification, each pixel
-// holds the original position it sampled.
-cv::Mat coordinateImage(const CameraModel& cam, bool y) {
-  cv::Mat image(cam.height_px, cam.width_px, CV_32F);
-  for (int r = 0; r < image.rows; ++r) {
-    for (int c = 0; c < image.cols; ++c) image.at<float>(r, c) = static_cast<float>(y ? r : c);
-  }
-  return image;
-}
-
-double bilinear(const cv::Mat& image, const Eigen::Vector2d& px) {
-  const int x0 = static_cast<int>(std::floor(px.x())), y0 = static_cast<int>(std::floor(px.y()));
-  const double ax = px.x() - x0, ay = px.y() - y0;
-  auto at = [&](int x, int y) { return static_cast<double>(image.at<float>(y, x)); };
-  return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
-         ay * ((1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
-}
-
-// Where the rectified image of `which` camera samples the original at the rectified projection of
-// each point, against the original model's projection: the worst miss in px.
-double worstMapError(const Rectifier& rect, const CameraModel& raw_left,
-                     const std::optional<CameraModel>& raw_right, bool right_camera) {
-  const CameraModel& raw = right_camera ? *raw_right : raw_left;
-  const CameraModel& model = right_camera ? *rect.right() : rect.left();
-  RectifiedImages xs, ys;
-  if (raw_right) {
-    xs = rect.rectify(coordinateImage(raw_left, false), coordinateImage(*raw_right, false));
-    ys = rect.rectify(coordinateImage(raw_left, true), coordinateImage(*raw_right, true));
-  } else {
-    xs = rect.rectify(coordinateImage(raw_left, false));
-    ys = rect.rectify(coordinateImage(raw_left, true));
-  }
-  const cv::Mat& x_img = right_camera ? xs.right : xs.left;
-  const cv::Mat& y_img = right_camera ? ys.right : ys.left;
-  double worst = 0.0;
-  for (const Eigen::Vector3d& p_b : visiblePoints(rect, raw_left, raw_right)) {
-    const Eigen::Vector2d rectified = projectPinhole(model, p_b);
-    const Eigen::Vector2d sampled(bilinear(x_img, rectified), bilinear(y_img, rectified));
-    worst = std::max(worst, (sampled - projectOriginal(raw, p_b)).norm());
-  }
-  return worst;
 }
 
 TEST(RectifierTest, StereoRigGetsOneKAndRowAlignedCameras) {
@@ -250,30 +159,21 @@ TEST(RectifierTest, UndistortedMonoAndZeroDistortionAreIdentity) {
   EXPECT_LT(worstMapError(rect2, kittiCam0(), turned, true), 0.05);
 }
 
-std::string errorOf(const CameraModel& left, const std::optional<CameraModel>& right) {
-  try {
-    const Rectifier rect(left, right);
-  } catch (const InvalidInput& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(RectifierTest, RefusesInvalidCamerasAndRigs) {
-  EXPECT_THAT(errorOf(kittiCam1(), kittiCam0()), HasSubstr("right of the left"));
-  EXPECT_THAT(errorOf(eurocCam1(), eurocCam0()), HasSubstr("side by side"));
+  EXPECT_THAT(rectifierError(kittiCam1(), kittiCam0()), HasSubstr("right of the left"));
+  EXPECT_THAT(rectifierError(eurocCam1(), eurocCam0()), HasSubstr("side by side"));
   CameraModel above = kittiCam0();  // a vertical rig
   above.T_b_c = above.T_b_c * Eigen::Translation3d(0.01, -0.5, 0.0);
-  EXPECT_THAT(errorOf(kittiCam0(), above), HasSubstr("side by side"));
+  EXPECT_THAT(rectifierError(kittiCam0(), above), HasSubstr("side by side"));
   CameraModel small = kittiCam1();
   small.width_px = 640;
-  EXPECT_THAT(errorOf(kittiCam0(), small), HasSubstr("different image sizes"));
+  EXPECT_THAT(rectifierError(kittiCam0(), small), HasSubstr("different image sizes"));
   CameraModel three = kittiCam0();
   three.distortion = {0.1, 0.01, 0.0};
-  EXPECT_THAT(errorOf(three, std::nullopt), HasSubstr("distortion coefficients"));
+  EXPECT_THAT(rectifierError(three, std::nullopt), HasSubstr("distortion coefficients"));
   CameraModel no_focal = kittiCam0();
   no_focal.fx = 0.0;
-  EXPECT_THAT(errorOf(no_focal, std::nullopt), HasSubstr("focal lengths"));
+  EXPECT_THAT(rectifierError(no_focal, std::nullopt), HasSubstr("focal lengths"));
 
   const Rectifier rect(eurocCam0(), eurocCam1());
   const cv::Mat wrong(480, 640, CV_8U), ok(480, 752, CV_8U);

@@ -251,6 +251,10 @@ TEST(VioEstimator, RefusesUnrectifiedOrIncompleteCameras) {
   distorted.distortion = {0.1, 0, 0, 0};
   config.mode = VioMode::kMonoImu;
   EXPECT_THROW(VioEstimator(config, distorted, std::nullopt), InvalidInput);
+  CameraModel fisheye = cam;  // k1..k4 = 0 is still a fisheye (r_d = theta), not a pinhole
+  fisheye.distortion_model = Distortion::kEquidistant;
+  fisheye.distortion = {0, 0, 0, 0};
+  EXPECT_THROW(VioEstimator(config, fisheye, std::nullopt), InvalidInput);
   config.window_size = 1;
   EXPECT_THROW(VioEstimator(config, cam, std::nullopt), InvalidInput);
 }
