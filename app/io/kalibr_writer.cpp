@@ -27,7 +27,7 @@ std::string kalibrCamchainYaml(const std::vector<CameraModel>& cameras,
   for (std::size_t i = 0; i < cameras.size(); ++i) {
     const CameraModel& cam = cameras[i];
     if (!cam.distortion.empty() && cam.distortion.size() != 4) {
-      throw InvalidInput("kalibrCamchainYaml: radtan takes 4 distortion coefficients");
+      throw InvalidInput("kalibrCamchainYaml: radtan and equidistant take 4 coefficients");
     }
     const Eigen::Isometry3d T_cam_imu = cam.T_b_c.inverse();
     out += fmt::format("cam{}:\n  T_cam_imu:\n{}", i, matrixYaml(T_cam_imu.matrix(), "  "));
@@ -39,10 +39,11 @@ std::string kalibrCamchainYaml(const std::vector<CameraModel>& cameras,
         cam.distortion.empty() ? std::vector<double>(4, 0.0) : cam.distortion;
     out += fmt::format(
         "  camera_model: pinhole\n  distortion_coeffs: [{}, {}, {}, {}]\n  distortion_model: "
-        "radtan\n  intrinsics: [{}, {}, {}, {}]\n  resolution: [{}, {}]\n  rostopic: {}\n  "
+        "{}\n  intrinsics: [{}, {}, {}, {}]\n  resolution: [{}, {}]\n  rostopic: {}\n  "
         "timeshift_cam_imu: {}\n",
-        d[0], d[1], d[2], d[3], cam.fx, cam.fy, cam.cx, cam.cy, cam.width_px, cam.height_px,
-        topics[i], timeshift_cam_imu_s);
+        d[0], d[1], d[2], d[3],
+        cam.distortion_model == Distortion::kEquidistant ? "equidistant" : "radtan", cam.fx, cam.fy,
+        cam.cx, cam.cy, cam.width_px, cam.height_px, topics[i], timeshift_cam_imu_s);
   }
   return out;
 }

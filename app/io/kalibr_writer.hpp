@@ -8,7 +8,8 @@
 
 namespace gvio::io {
 
-// camN blocks: pinhole intrinsics, radtan distortion (zeros when none), resolution, T_cam_imu
+// camN blocks: pinhole intrinsics, radtan (zeros when none) or equidistant distortion, resolution,
+// T_cam_imu
 // (= T_b_c^-1, the body being the IMU), T_cn_cnm1 from cam1 on, timeshift_cam_imu and rostopic.
 std::string kalibrCamchainYaml(const std::vector<CameraModel>& cameras,
                                const std::vector<std::string>& topics, double timeshift_cam_imu_s);

@@ -17,6 +17,7 @@
 #include "io/dataset.hpp"
 #include "io/input_error.hpp"
 #include "io/kalibr.hpp"
+#include "io/kalibr_writer.hpp"
 #include "odometry/rectifier.hpp"
 #include "support/euroc_camera.hpp"
 #include "support/fixtures.hpp"
@@ -289,6 +290,42 @@ TEST(CliKalibr, TheDrivesOwnCalibrationAsKalibrFilesGivesTheSameRun) {
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_THAT(bad.err, AllOf(HasSubstr("fov.yaml:"), HasSubstr("'fov' is not supported")));
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+}
+
+}  // namespace
+}  // namespace gvio::io
+
+namespace gvio::io {
+namespace {
+
+// What gvio simulate --format rosbag writes reads back as the same cameras, topics and noise.
+TEST(KalibrWriter, RoundTripsThroughTheReader) {
+  test::TempDir dir("kalibr_writer");
+  CameraModel c0 = test::eurocCam0(), c1 = test::eurocCam1();
+  c1.distortion_model = Distortion::kEquidistant;
+  c1.distortion = {0.01, -0.002, 0.0003, -0.00004};
+  test::writeText(dir.path() / "camchain.yaml",
+                  kalibrCamchainYaml({c0, c1}, {"/left", "/right"}, -0.015));
+  ImuNoise noise;
+  noise.acc_noise_density = 0.003;
+  test::writeText(dir.path() / "imu.yaml", kalibrImuYaml(noise, 200.0, "/imu"));
+  const KalibrCalibration k = readKalibr({dir.path() / "camchain.yaml", dir.path() / "imu.yaml"});
+  ASSERT_EQ(k.cameras.size(), 2U);
+  EXPECT_EQ(k.camera_topics, (std::vector<std::string>{"/left", "/right"}));
+  EXPECT_EQ(k.imu_topic, "/imu");
+  EXPECT_DOUBLE_EQ(k.timeshift_cam_imu_s, -0.015);
+  ASSERT_TRUE(k.imu_noise);
+  EXPECT_DOUBLE_EQ(k.imu_noise->acc_noise_density, 0.003);
+  const CameraModel* in[] = {&c0, &c1};
+  for (std::size_t i = 0; i < 2; ++i) {
+    const CameraModel& got = k.cameras[i];
+    EXPECT_EQ(got.distortion_model, in[i]->distortion_model) << i;
+    EXPECT_EQ(got.distortion, in[i]->distortion) << i;
+    EXPECT_DOUBLE_EQ(got.fx, in[i]->fx);
+    EXPECT_EQ(got.width_px, in[i]->width_px);
+    EXPECT_LT((got.T_b_c.matrix() - in[i]->T_b_c.matrix()).cwiseAbs().maxCoeff(), 1e-12) << i;
+  }
+  EXPECT_TRUE(k.warnings.empty());  // T_cn_cnm1 agrees with the two T_cam_imu
 }
 
 }  // namespace

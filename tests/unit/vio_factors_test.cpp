@@ -12,6 +12,7 @@
 #include "odometry/pose_manifold.hpp"
 #include "odometry/prior_factor.hpp"
 #include "odometry/reprojection_factor.hpp"
+#include "odometry/time_offset_factor.hpp"
 #include "support/ceres_jacobian.hpp"
 #include "support/numeric_jacobian.hpp"
 
@@ -202,6 +203,91 @@ TEST(SameFrameReprojectionFactor, StereoDisparityAndJacobian) {
   const auto num = numericTangentJacobian<2>(factor, blocks, 0, false);
   const auto ana = analyticTangentJacobian<2>(factor, blocks, 0, false);
   EXPECT_LT((num - ana).norm(), 1e-6 * std::max(1.0, ana.norm()));
+}
+
+// Time-offset factors (Qin and Shen 2018): the analytic t_d column and the rest match central
+// differences; at t_d = 0 they are the plain factors; the true t_d zeroes the residual of a point
+// whose observations were taken t_d before their stamps.
+TEST(ReprojectionTimeOffsetFactor, JacobiansMatchNumericDerivatives) {
+  const ReprojectionSetup s = makeReprojectionSetup();
+  std::vector<std::vector<double>> blocks = s.blocks;
+  blocks.push_back({0.013});
+  const Eigen::Vector2d anchor_px(s.left.fx * s.bearing.x() + s.left.cx,
+                                  s.left.fy * s.bearing.y() + s.left.cy);
+  const MovingPixel anchor{anchor_px, Eigen::Vector2d(-120.0, 35.0)};
+  for (const PinholeView* observer : {&s.left, &s.right}) {
+    const ReprojectionTimeOffsetFactor factor(anchor, s.left, *observer,
+                                              {Eigen::Vector2d(650.0, 170.0), {-90.0, 20.0}}, 1.5);
+    for (std::size_t b = 0; b < 4; ++b) {
+      const bool is_pose = b < 2;
+      const auto num = numericTangentJacobian<2>(factor, blocks, b, is_pose);
+      const auto ana = analyticTangentJacobian<2>(factor, blocks, b, is_pose);
+      EXPECT_LT((num - ana).norm(), 1e-5 * std::max(1.0, ana.norm())) << "block " << b;
+    }
+  }
+  // At t_d = 0 the plain factor: same residual, same Jacobians.
+  blocks[3][0] = 0.0;
+  const ReprojectionTimeOffsetFactor with_td(anchor, s.left, s.right,
+                                             {Eigen::Vector2d(650.0, 170.0), {-90.0, 20.0}}, 1.5);
+  const ReprojectionFactor plain(s.bearing, s.left.T_b_c, s.right, Eigen::Vector2d(650.0, 170.0),
+                                 1.5);
+  for (std::size_t b = 0; b < 3; ++b) {
+    EXPECT_LT((analyticTangentJacobian<2>(with_td, blocks, b, b < 2) -
+               analyticTangentJacobian<2>(plain, s.blocks, b, b < 2))
+                  .norm(),
+              1e-12)
+        << b;
+  }
+}
+
+TEST(ReprojectionTimeOffsetFactor, TheTrueOffsetExplainsObservationsTakenBeforeTheirStamps) {
+  const ReprojectionSetup s = makeReprojectionSetup();
+  const auto project = [](const PinholeView& cam, const Eigen::Isometry3d& T_w_b,
+                          const Eigen::Vector3d& P_w) {
+    const Eigen::Vector3d P_c = (T_w_b * cam.T_b_c).inverse() * P_w;
+    return Eigen::Vector2d(cam.fx * P_c.x() / P_c.z() + cam.cx,
+                           cam.fy * P_c.y() / P_c.z() + cam.cy);
+  };
+  const Eigen::Isometry3d T_i = poseFromBlock(s.blocks[0].data());
+  const Eigen::Isometry3d T_j = poseFromBlock(s.blocks[1].data());
+  const Eigen::Vector3d P_w = T_i * s.left.T_b_c * (s.bearing / s.blocks[2][0]);
+  // The poses are at the stamps; the images were exposed t_d earlier, while the point moved
+  // across the image at these velocities.
+  const double t_d = 0.02;
+  const Eigen::Vector2d v_i(-150.0, 40.0), v_j(-80.0, 25.0);
+  const MovingPixel anchor{project(s.left, T_i, P_w) - t_d * v_i, v_i};
+  const MovingPixel seen{project(s.right, T_j, P_w) - t_d * v_j, v_j};
+  const ReprojectionTimeOffsetFactor factor(anchor, s.left, s.right, seen, 1.0);
+  std::vector<double> offset = {t_d};
+  const double* params[] = {s.blocks[0].data(), s.blocks[1].data(), s.blocks[2].data(),
+                            offset.data()};
+  Eigen::Vector2d r;
+  ASSERT_TRUE(factor.Evaluate(params, r.data(), nullptr));
+  EXPECT_LT(r.norm(), 1e-9);
+  offset[0] = 0.0;  // ignoring the offset leaves pixels of error
+  ASSERT_TRUE(factor.Evaluate(params, r.data(), nullptr));
+  EXPECT_GT(r.norm(), 1.0);
+}
+
+TEST(SameFrameTimeOffsetFactor, JacobiansMatchNumericDerivatives) {
+  const ReprojectionSetup s = makeReprojectionSetup();
+  const double depth = 12.0;
+  const MovingPixel anchor{Eigen::Vector2d(s.left.cx + 40.0, s.left.cy - 10.0), {-60.0, 5.0}};
+  const MovingPixel right{
+      Eigen::Vector2d(s.left.cx + 40.0 - s.left.fx * 0.537 / depth, s.left.cy - 10.0),
+      {-55.0, 5.0}};
+  const SameFrameTimeOffsetFactor factor(anchor, s.left, s.right, right, 1.0);
+  std::vector<std::vector<double>> blocks = {{1.0 / depth}, {0.0}};
+  const double* params[] = {blocks[0].data(), blocks[1].data()};
+  Eigen::Vector2d r;
+  ASSERT_TRUE(factor.Evaluate(params, r.data(), nullptr));
+  EXPECT_LT(r.norm(), 1e-9);  // t_d = 0: the plain stereo residual
+  blocks = {{1.0 / 9.0}, {0.03}};
+  for (std::size_t b = 0; b < 2; ++b) {
+    const auto num = numericTangentJacobian<2>(factor, blocks, b, false);
+    const auto ana = analyticTangentJacobian<2>(factor, blocks, b, false);
+    EXPECT_LT((num - ana).norm(), 1e-6 * std::max(1.0, ana.norm())) << b;
+  }
 }
 
 TEST(PosePriorFactor, JacobianAndWorldFrameSigmas) {
