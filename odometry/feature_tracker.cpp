@@ -161,8 +161,8 @@ TrackedFrame FeatureTracker::track(std::int64_t t_ns, const cv::Mat& left, const
 
   auto start = Clock::now();
   buildPyramid(left, left_pyr_);
-  if (has_prev_ && !tracks_.empty())
-    trackPrevious(1e-9 * static_cast<double>(t_ns - prev_t_ns_), stats);
+  dt_s_ = has_prev_ ? 1e-9 * static_cast<double>(t_ns - prev_t_ns_) : 0.0;
+  if (has_prev_ && !tracks_.empty()) trackPrevious(dt_s_, stats);
   stats.ms_track = msSince(start);
 
   start = Clock::now();
@@ -177,7 +177,7 @@ TrackedFrame FeatureTracker::track(std::int64_t t_ns, const cv::Mat& left, const
   } else {
     for (const Track& t : tracks_) {
       out.features.push_back(Feature{t.id, toEigen(t.px), false, Eigen::Vector2d::Zero(), t.length,
-                                     toEigen(t.velocity_pxps)});
+                                     toEigen(t.velocity_pxps), toEigen(t.velocity_pxps)});
     }
   }
   stats.ms_stereo = msSince(start);
@@ -357,6 +357,10 @@ std::vector<Feature> FeatureTracker::matchStereo(TrackerStats& stats) {
     const bool match = ok[i] && inside(r, image_size_) &&
                        std::abs(r.y - l.y) <= static_cast<float>(config_.stereo_max_vertical_px) &&
                        r.x <= l.x;
+    Eigen::Vector2d velocity_right = toEigen(t.velocity_pxps);
+    if (match && t.has_disparity && t.length > 1 && dt_s_ > 0.0) {
+      velocity_right.x() -= static_cast<double>(l.x - r.x - t.disparity) / dt_s_;
+    }
     t.has_disparity = match;
     t.disparity = match ? l.x - r.x : 0.0F;
     if (match) {
@@ -366,7 +370,7 @@ std::vector<Feature> FeatureTracker::matchStereo(TrackerStats& stats) {
     }
     features.push_back(Feature{t.id, toEigen(l), match,
                                match ? toEigen(r) : Eigen::Vector2d::Zero().eval(), t.length,
-                               toEigen(t.velocity_pxps)});
+                               toEigen(t.velocity_pxps), velocity_right});
   }
   return features;
 }

@@ -38,6 +38,9 @@ struct Feature {
   // Image-plane velocity of the left pixel since the previous frame (px/s; zero for a new
   // feature): the time-offset factors shift observations along it.
   Eigen::Vector2d velocity_pxps = Eigen::Vector2d::Zero();
+  // The right pixel's: the left one's less the change of disparity (rectified rows), when the
+  // feature had a stereo match in the previous frame too; else the left one's.
+  Eigen::Vector2d velocity_right_pxps = Eigen::Vector2d::Zero();
 };
 
 struct TrackerStats {
@@ -106,6 +109,7 @@ class FeatureTracker {
   std::vector<Track> tracks_;   // features of the previous (then current) left image
   bool has_prev_ = false;       // prev_pyr_ holds the previous left image (false after reset())
   std::int64_t prev_t_ns_ = 0;  // its stamp
+  double dt_s_ = 0.0;           // this frame's stamp minus the previous one's (0: none)
   cv::Size image_size_;
   // Image buffers kept from frame to frame only so that OpenCV reuses their memory: fresh
   // megabyte-sized allocations each frame cost more in page faults than the arithmetic on them.

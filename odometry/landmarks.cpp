@@ -37,7 +37,15 @@ const Observation* Landmark::in(std::uint64_t frame_uid) const {
 bool LandmarkMap::observe(std::uint64_t id, const Observation& obs) {
   auto it = landmarks_.find(id);
   if (it == landmarks_.end()) return false;
-  it->second.observations.push_back(obs);
+  std::vector<Observation>& seen = it->second.observations;
+  // A feature detected in its anchor frame has no image velocity there yet: it takes the one it
+  // shows next (its displacement to the next frame), which the time-offset factors need for the
+  // anchor's bearing too.
+  if (seen.size() == 1 && seen.front().velocity_pxps.isZero(0.0)) {
+    seen.front().velocity_pxps = obs.velocity_pxps;
+    seen.front().velocity_right_pxps = obs.velocity_right_pxps;
+  }
+  seen.push_back(obs);
   return true;
 }
 

@@ -18,7 +18,8 @@ struct Observation {
   Eigen::Vector2d px_left = Eigen::Vector2d::Zero();
   bool has_right = false;
   Eigen::Vector2d px_right = Eigen::Vector2d::Zero();
-  Eigen::Vector2d velocity_pxps = Eigen::Vector2d::Zero();  // left image, px/s (tracker's)
+  Eigen::Vector2d velocity_pxps = Eigen::Vector2d::Zero();        // left image, px/s (tracker's)
+  Eigen::Vector2d velocity_right_pxps = Eigen::Vector2d::Zero();  // right image
 };
 
 struct Landmark {

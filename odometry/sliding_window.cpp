@@ -112,8 +112,7 @@ int SlidingWindow::landmarkFactors(Landmark& lm, const FactorSink& raw_sink,
   return forwarded;
 }
 
-// The same residuals with t_d as a block. The right image moves with the left one's velocity
-// (rectified pair: same rows, nearly the same flow).
+// The same residuals with t_d as a block, each pixel moving at its own image's velocity.
 void SlidingWindow::timeOffsetFactors(Landmark& lm, const WindowFrame& anchor,
                                       const FactorSink& sink) const {
   double* t_d = time_offset_s_.get();
@@ -123,7 +122,7 @@ void SlidingWindow::timeOffsetFactors(Landmark& lm, const WindowFrame& anchor,
   const MovingPixel anchor_px{a.px_left, a.velocity_pxps};
   if (geometry_.stereo && a.has_right) {
     sink(std::make_shared<SameFrameTimeOffsetFactor>(anchor_px, geometry_.left, geometry_.right,
-                                                     MovingPixel{a.px_right, a.velocity_pxps},
+                                                     MovingPixel{a.px_right, a.velocity_right_pxps},
                                                      sigma),
          loss, {&lm.inv_depth, t_d});
   }
@@ -138,8 +137,8 @@ void SlidingWindow::timeOffsetFactors(Landmark& lm, const WindowFrame& anchor,
          loss, {anchor_pose, f->pose.data(), &lm.inv_depth, t_d});
     if (geometry_.stereo && o.has_right) {
       sink(std::make_shared<ReprojectionTimeOffsetFactor>(
-               anchor_px, geometry_.left, geometry_.right, MovingPixel{o.px_right, o.velocity_pxps},
-               sigma),
+               anchor_px, geometry_.left, geometry_.right,
+               MovingPixel{o.px_right, o.velocity_right_pxps}, sigma),
            loss, {anchor_pose, f->pose.data(), &lm.inv_depth, t_d});
     }
   }

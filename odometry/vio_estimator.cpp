@@ -154,6 +154,7 @@ void VioEstimator::Impl::addObservations(const WindowFrame& f, const TrackedFram
     o.has_right = geometry.stereo && feat.has_right;
     o.px_right = feat.px_right;
     o.velocity_pxps = feat.velocity_pxps;
+    o.velocity_right_pxps = feat.velocity_right_pxps;
     if (window.landmarks().observe(feat.id, o)) continue;
     if (f.keyframe) {
       window.landmarks().create(feat.id, o, geometry, config.min_depth_m, config.max_depth_m);

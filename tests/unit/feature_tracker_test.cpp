@@ -203,6 +203,38 @@ TEST_F(FeatureTrackerTest, TracksAgreeWithTheTrueMotion) {
   EXPECT_LT(p90, 2.0);
 }
 
+// Image velocities (for the camera-IMU time offset): a tracked feature's is its displacement
+// since the previous frame over the stamps' difference, left and right (the right one along x from
+// the change of disparity, along y the left one's: rectified rows); a new feature's is zero.
+TEST_F(FeatureTrackerTest, VelocitiesAreTheDisplacementSinceThePreviousFrame) {
+  int checked = 0, checked_right = 0, fresh = 0;
+  for (std::size_t k = 1; k < tracked_.size(); ++k) {
+    const double dt_s = 1e-9 * static_cast<double>(tracked_[k].t_ns - tracked_[k - 1].t_ns);
+    const auto previous = byId(tracked_[k - 1]);
+    for (const Feature& f : tracked_[k].features) {
+      const auto it = previous.find(f.id);
+      if (it == previous.end()) {
+        EXPECT_TRUE(f.velocity_pxps.isZero(0.0));
+        ++fresh;
+        continue;
+      }
+      const Eigen::Vector2d expected = (f.px_left - it->second.px_left) / dt_s;
+      EXPECT_LT((f.velocity_pxps - expected).norm(), 1e-3 * std::max(1.0, expected.norm()));
+      ++checked;
+      if (f.has_right && it->second.has_right) {
+        const double expected_right_x = (f.px_right.x() - it->second.px_right.x()) / dt_s;
+        EXPECT_NEAR(f.velocity_right_pxps.x(), expected_right_x,
+                    1e-3 * std::max(1.0, std::abs(expected_right_x)));
+        EXPECT_EQ(f.velocity_right_pxps.y(), f.velocity_pxps.y());
+        ++checked_right;
+      }
+    }
+  }
+  EXPECT_GT(checked, 1000);
+  EXPECT_GT(checked_right, 1000);
+  EXPECT_GT(fresh, 0);
+}
+
 // Frame k + 1 with a 200 x 150 region (around the focus of expansion) replaced by the content 40 px
 // right and 40 px down: the tracks that started in the region must be rejected, the others must
 // survive as on the clean frame. KLT may well find the displaced content (the forward-backward
