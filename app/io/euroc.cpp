@@ -29,14 +29,17 @@ CameraModel readCameraYaml(const fs::path& file, const std::string& name) {
   const std::string model = y["camera_model"] ? y["camera_model"].Scalar() : "pinhole";
   const std::string dist =
       y["distortion_model"] ? y["distortion_model"].Scalar() : "radial-tangential";
-  if (model != "pinhole" || (dist != "radial-tangential" && dist != "radtan")) {
-    throw InputError(
-        file, 0,
-        fmt::format("unsupported camera model '{}' / '{}' (pinhole radial-tangential only)", model,
-                    dist));
+  // TUM VI ships its fisheye rigs in this layout with the equidistant (Kannala-Brandt) model.
+  const bool equidistant = dist == "equidistant";
+  if (model != "pinhole" || (dist != "radial-tangential" && dist != "radtan" && !equidistant)) {
+    throw InputError(file, lineOf(y["distortion_model"] ? y["distortion_model"] : y),
+                     fmt::format("unsupported camera model '{}' / '{}' (pinhole with "
+                                 "radial-tangential or equidistant distortion)",
+                                 model, dist));
   }
   CameraModel cam = pinholeCamera(y, name, file);
   cam.distortion = yamlList<double>(y, "distortion_coefficients", 4, file);
+  if (equidistant) cam.distortion_model = Distortion::kEquidistant;
   cam.T_b_c = yamlTransform(y, file);
   return cam;
 }

@@ -216,6 +216,24 @@ TEST_F(EurocTest, CameraWithoutSensorYaml) {
   EXPECT_TRUE(names(error(), mav0() / "cam0" / "sensor.yaml", 0, "not found"));
 }
 
+// TUM VI's layout: EuRoC folders whose sensor.yaml names the equidistant (fisheye) model.
+TEST_F(EurocTest, EquidistantCamerasAreFisheyeAndOtherModelsAreRefused) {
+  writeImu(10);
+  writeCamera("cam0", 2);
+  const fs::path yaml = mav0() / "cam0" / "sensor.yaml";
+  test::replaceLine(yaml, 7, "distortion_model: equidistant");
+  test::replaceLine(yaml, 8, "distortion_coefficients: [0.0034, 0.0007, -0.0021, 0.0002]");
+  const Dataset ds = read();
+  ASSERT_EQ(ds.cameras.size(), 1U);
+  EXPECT_EQ(ds.cameras[0].distortion_model, Distortion::kEquidistant);
+  EXPECT_EQ(ds.cameras[0].distortion, (std::vector<double>{0.0034, 0.0007, -0.0021, 0.0002}));
+
+  writeCamera("cam0", 2);
+  EXPECT_EQ(read().cameras[0].distortion_model, Distortion::kRadtan);
+  test::replaceLine(yaml, 7, "distortion_model: fov");
+  EXPECT_TRUE(names(error(), yaml, 7, "unsupported camera model 'pinhole' / 'fov'"));
+}
+
 TEST_F(EurocTest, MalformedSensorYaml) {
   writeCamera("cam0", 2);
   const fs::path yaml = mav0() / "cam0" / "sensor.yaml";
