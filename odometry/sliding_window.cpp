@@ -113,7 +113,7 @@ int SlidingWindow::landmarkFactors(Landmark& lm, const FactorSink& raw_sink,
 }
 
 // The same residuals with t_d as a block, each pixel moving at its own image's velocity.
-void SlidingWindow::timeOffsetFactors(Landmark& lm, const WindowFrame& anchor,
+void SlidingWindow::timeOffsetFactors(Landmark& lm, WindowFrame& anchor,
                                       const FactorSink& sink) const {
   double* t_d = time_offset_s_.get();
   const double sigma = config_.pixel_sigma_px;
@@ -126,7 +126,7 @@ void SlidingWindow::timeOffsetFactors(Landmark& lm, const WindowFrame& anchor,
                                                      sigma),
          loss, {&lm.inv_depth, t_d});
   }
-  double* anchor_pose = const_cast<double*>(anchor.pose.data());
+  double* anchor_pose = anchor.pose.data();
   for (std::size_t k = 1; k < lm.observations.size(); ++k) {
     const Observation& o = lm.observations[k];
     WindowFrame* f = find(o.frame_uid);

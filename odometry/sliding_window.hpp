@@ -97,7 +97,7 @@ class SlidingWindow {
   // Reprojection factors of one landmark (left, and right where matched) that evaluate at the
   // current state; returns how many were handed to `sink`.
   int landmarkFactors(Landmark& lm, const FactorSink& sink, bool with_time_offset) const;
-  void timeOffsetFactors(Landmark& lm, const WindowFrame& anchor, const FactorSink& sink) const;
+  void timeOffsetFactors(Landmark& lm, WindowFrame& anchor, const FactorSink& sink) const;
   [[nodiscard]] bool estimatesTimeOffset(bool use_imu) const {
     return use_imu && config_.estimate_time_offset;
   }

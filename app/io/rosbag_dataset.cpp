@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <numeric>
 
 #include "io/input_error.hpp"
 #include "io/ros_image.hpp"
@@ -36,10 +35,9 @@ std::vector<std::string> topicsOfType(const std::vector<bag::TopicInfo>& topics,
 }
 
 // Two topics are a stereo pair when they are the same name but for one left/right token.
-bool stereoPair(std::string a, std::string b) {
+bool stereoPair(const std::string& a, const std::string& b) {
   static const std::pair<const char*, const char*> kTokens[] = {
       {"left", "right"}, {"0", "1"}, {"1", "2"}, {"l", "r"}};
-  if (a.size() == 0) return false;
   for (const auto& [l, r] : kTokens) {
     for (std::size_t pos = a.find(l); pos != std::string::npos; pos = a.find(l, pos + 1)) {
       std::string swapped = a;
