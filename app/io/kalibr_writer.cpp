@@ -26,8 +26,12 @@ std::string kalibrCamchainYaml(const std::vector<CameraModel>& cameras,
   std::string out;
   for (std::size_t i = 0; i < cameras.size(); ++i) {
     const CameraModel& cam = cameras[i];
-    if (!cam.distortion.empty() && cam.distortion.size() != 4) {
-      throw InvalidInput("kalibrCamchainYaml: radtan and equidistant take 4 coefficients");
+    // Kalibr's radtan has no k3: OpenCV's 5-coefficient form is written only when k3 is 0.
+    const bool plain_k3 = cam.distortion_model == Distortion::kRadtan &&
+                          cam.distortion.size() == 5 && cam.distortion[4] == 0.0;
+    if (!cam.distortion.empty() && cam.distortion.size() != 4 && !plain_k3) {
+      throw InvalidInput(
+          "kalibrCamchainYaml: radtan and equidistant take 4 coefficients (radtan 5 with k3 0)");
     }
     const Eigen::Isometry3d T_cam_imu = cam.T_b_c.inverse();
     out += fmt::format("cam{}:\n  T_cam_imu:\n{}", i, matrixYaml(T_cam_imu.matrix(), "  "));

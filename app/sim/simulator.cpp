@@ -135,20 +135,6 @@ io::TriangleMesh worldMesh(const render::Scene& scene) {
   return mesh;
 }
 
-CameraModel cameraModel(const render::PinholeIntrinsics& K, const Eigen::Isometry3d& T_b_c,
-                        std::size_t index) {
-  CameraModel cam;
-  cam.name = "cam" + std::to_string(index);
-  cam.width_px = K.width;
-  cam.height_px = K.height;
-  cam.fx = K.fx;
-  cam.fy = K.fy;
-  cam.cx = K.cx;
-  cam.cy = K.cy;
-  cam.T_b_c = T_b_c;
-  return cam;
-}
-
 // Every parameter of the run: the request, the effective configuration, and what came out.
 void writeSimYaml(const fs::path& file, const SimRequest& r, const SimSummary& s) {
   YAML::Emitter y;
@@ -263,9 +249,10 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
   writeKittiCalibration(r.out, K, r.stereo);
   std::vector<int> ids = {0};
   if (r.stereo) ids.push_back(1);
+  const std::vector<CameraModel> calibrated =
+      io::readKittiCameras(io::findKittiCalib(r.out), ids, false);
   std::vector<Eigen::Isometry3d> T_b_c;
-  for (const auto& cam : io::readKittiCameras(io::findKittiCalib(r.out), ids, false))
-    T_b_c.push_back(cam.T_b_c);
+  for (const auto& cam : calibrated) T_b_c.push_back(cam.T_b_c);
 
   // Camera frames, rendered and written one at a time (memory stays flat).
   const render::EglContext context;
@@ -306,9 +293,7 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
     io::writeTextAtomic(r.out / "gnss" / "fixes.nmea", toNmeaLog(fixes));
     io::writeTextAtomic(r.out / "gnss" / "data.csv", toGnssCsv(fixes));
   } else if (bag) {
-    std::vector<CameraModel> models;
-    for (std::size_t c = 0; c < ids.size(); ++c) models.push_back(cameraModel(K, T_b_c[c], c));
-    bag->finish(imu, fixes, models, summary.imu_noise.noise, config.imu_rate_hz);
+    bag->finish(imu, fixes, calibrated, summary.imu_noise.noise, config.imu_rate_hz);
   } else {
     for (std::size_t c = 0; c < ids.size(); ++c)
       writeEurocCamera(r.out, ids[c], stamp_t, K, T_b_c[c], config.camera_rate_hz);

@@ -3,6 +3,7 @@
 // rectifier tests: points projected through the raw (distorted) models, and images whose pixels
 // hold their own coordinates, which show after rectification where each rectified pixel sampled
 // the raw image.
+#include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
@@ -74,6 +75,36 @@ inline std::vector<Eigen::Vector3d> visiblePoints(const odometry::Rectifier& rec
     if (ok) points.push_back(p_b);
   }
   return points;
+}
+
+// The rectified stereo contract, whatever the lens model: no distortion, one K, the camera
+// centres where they were, the raw baseline, the right camera the left one moved along its own x
+// axis, and every visible point on the same row in both images with a positive disparity.
+inline void expectStereoContract(const odometry::Rectifier& rect, const CameraModel& raw_l,
+                                 const CameraModel& raw_r) {
+  ASSERT_TRUE(rect.isStereo());
+  const CameraModel& l = rect.left();
+  const CameraModel& r = *rect.right();
+  EXPECT_TRUE(l.distortion.empty());
+  EXPECT_TRUE(r.distortion.empty());
+  EXPECT_DOUBLE_EQ(l.fx, r.fx);
+  EXPECT_DOUBLE_EQ(l.fy, r.fy);
+  EXPECT_DOUBLE_EQ(l.cx, r.cx);
+  EXPECT_DOUBLE_EQ(l.cy, r.cy);
+  // Rectification turns the cameras about their centres: the centres stay where they were.
+  EXPECT_LT((l.T_b_c.translation() - raw_l.T_b_c.translation()).norm(), 1e-12);
+  EXPECT_LT((r.T_b_c.translation() - raw_r.T_b_c.translation()).norm(), 1e-9);
+  const double raw_baseline = (raw_r.T_b_c.translation() - raw_l.T_b_c.translation()).norm();
+  EXPECT_NEAR(rect.baselineM(), raw_baseline, 1e-12);
+  // The right camera differs from the left only by +baseline along the left x axis.
+  const Eigen::Isometry3d T_l_r = l.T_b_c.inverse() * r.T_b_c;
+  EXPECT_LT((T_l_r.linear() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+  EXPECT_LT((T_l_r.translation() - Eigen::Vector3d(rect.baselineM(), 0, 0)).norm(), 1e-12);
+  for (const Eigen::Vector3d& p_b : visiblePoints(rect, raw_l, raw_r)) {
+    const Eigen::Vector2d pl = projectPinhole(l, p_b), pr = projectPinhole(r, p_b);
+    EXPECT_NEAR(pl.y(), pr.y(), 0.05);
+    EXPECT_GT(pl.x(), pr.x());
+  }
 }
 
 // An image whose pixels hold their own x (or y) coordinate: after rectification, each pixel

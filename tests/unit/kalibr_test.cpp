@@ -326,6 +326,14 @@ TEST(KalibrWriter, RoundTripsThroughTheReader) {
     EXPECT_LT((got.T_b_c.matrix() - in[i]->T_b_c.matrix()).cwiseAbs().maxCoeff(), 1e-12) << i;
   }
   EXPECT_TRUE(k.warnings.empty());  // T_cn_cnm1 agrees with the two T_cam_imu
+
+  // OpenCV's five radtan coefficients (KITTI's calibration) are Kalibr's four when k3 is 0.
+  c0.distortion = {0.01, -0.02, 0.001, 0.002, 0.0};
+  test::writeText(dir.path() / "five.yaml", kalibrCamchainYaml({c0}, {"/left"}, 0.0));
+  EXPECT_EQ(readKalibr({dir.path() / "five.yaml"}).cameras[0].distortion,
+            (std::vector<double>{0.01, -0.02, 0.001, 0.002}));
+  c0.distortion[4] = 0.003;
+  EXPECT_THROW((void)kalibrCamchainYaml({c0}, {"/left"}, 0.0), InvalidInput);
 }
 
 }  // namespace

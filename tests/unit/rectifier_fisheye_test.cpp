@@ -19,6 +19,7 @@
 
 namespace gvio::odometry {
 namespace {
+using test::expectStereoContract;
 using test::projectPinhole;
 using test::projectRaw;
 using test::rectifierError;
@@ -82,38 +83,26 @@ TEST(RectifierFisheyeTest, StereoRigGetsOneKAndRowAlignedCameras) {
   const Rectifier rect(raw_l, raw_r);
   EXPECT_FALSE(rect.isIdentity());
   ASSERT_TRUE(rect.isStereo());
+  expectStereoContract(rect, raw_l, raw_r);
   const CameraModel& l = rect.left();
   const CameraModel& r = *rect.right();
   for (const CameraModel* cam : {&l, &r}) {
-    EXPECT_TRUE(cam->distortion.empty());
     EXPECT_EQ(cam->distortion_model, Distortion::kRadtan);  // a pinhole
     EXPECT_EQ(cam->width_px, 512);
     EXPECT_EQ(cam->height_px, 512);
   }
   EXPECT_EQ(r.name, "cam1");
-  EXPECT_DOUBLE_EQ(l.fx, r.fx);
-  EXPECT_DOUBLE_EQ(l.fy, r.fy);
-  EXPECT_DOUBLE_EQ(l.cx, r.cx);
-  EXPECT_DOUBLE_EQ(l.cy, r.cy);
   // Rectification turns the cameras about their centres, by about half the 2.7 deg between them
   // each, not by a quarter turn onto some other axis.
-  EXPECT_LT((l.T_b_c.translation() - raw_l.T_b_c.translation()).norm(), 1e-12);
-  EXPECT_LT((r.T_b_c.translation() - raw_r.T_b_c.translation()).norm(), 1e-9);
   EXPECT_LT(Eigen::AngleAxisd(raw_l.T_b_c.linear().transpose() * l.T_b_c.linear()).angle(),
             3.0 * M_PI / 180.0);
   EXPECT_LT(Eigen::AngleAxisd(raw_r.T_b_c.linear().transpose() * r.T_b_c.linear()).angle(),
             3.0 * M_PI / 180.0);
-  const double raw_baseline = (raw_r.T_b_c.translation() - raw_l.T_b_c.translation()).norm();
-  EXPECT_NEAR(rect.baselineM(), raw_baseline, 1e-12);
   EXPECT_NEAR(rect.baselineM(), 0.1011, 1e-3);
-  const Eigen::Isometry3d T_l_r = l.T_b_c.inverse() * r.T_b_c;
-  EXPECT_LT((T_l_r.linear() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
-  EXPECT_LT((T_l_r.translation() - Eigen::Vector3d(rect.baselineM(), 0, 0)).norm(), 1e-12);
-  // Same row in both rectified images; disparity f b / z.
+  // Disparity f b / z.
   for (const Eigen::Vector3d& p_b : visiblePoints(rect, raw_l, raw_r)) {
     const Eigen::Vector2d pl = projectPinhole(l, p_b), pr = projectPinhole(r, p_b);
     const double z_m = (l.T_b_c.inverse() * p_b).z();
-    EXPECT_NEAR(pl.y(), pr.y(), 0.05);
     EXPECT_NEAR(pl.x() - pr.x(), l.fx * rect.baselineM() / z_m, 1e-6);
   }
 }
