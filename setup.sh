@@ -4,6 +4,12 @@
 #   ./setup.sh demo    the main job on the embedded demo input (the default)
 #   ./setup.sh test    every test (ctest); this is what CI runs
 #   ./setup.sh build   install + build only
+#   ./setup.sh sanitize [quick]
+#                      the test suite built with AddressSanitizer + UndefinedBehaviorSanitizer
+#                      (clang, in build-san; quick: without the slow drives); SANITIZE_EXCLUDE
+#                      (a ctest -E regex) skips tests
+#   ./setup.sh fuzz [SECONDS [TARGET...]]
+#                      every libFuzzer target (tests/fuzz) for SECONDS each (default 60)
 # Idempotent and non-interactive. Environment: BUILD_DIR (default build), JOBS (default nproc).
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -22,6 +28,9 @@ PACKAGES=(
 # Only the modes that build the test suite need its frameworks.
 TEST_PACKAGES=(libgtest-dev libgmock-dev libbenchmark-dev)
 [ "$mode" != demo ] && PACKAGES+=("${TEST_PACKAGES[@]}")
+# Sanitizers and libFuzzer come with clang.
+SANITIZER_PACKAGES=(clang-14 libfuzzer-14-dev libclang-rt-14-dev)
+case "$mode" in sanitize | fuzz) PACKAGES+=("${SANITIZER_PACKAGES[@]}") ;; esac
 
 install_packages() {
   local missing=()
@@ -50,14 +59,56 @@ build() {
   cmake --build "$BUILD_DIR" -j "$JOBS" "${target[@]}"
 }
 
+# The instrumented build with clang: build_instrumented DIR SANITIZERS [ninja targets...]. Every
+# target carries the sanitizers and libFuzzer's coverage, so that the fuzz targets and the
+# sanitized suite share one build. -O1 keeps asserts on and the drives bearable.
+build_instrumented() {
+  local dir="$1" sanitizers="$2"
+  shift 2
+  CC=clang-14 CXX=clang++-14 cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -DGVIO_SANITIZE="$sanitizers" -DGVIO_FUZZ=ON \
+    -DGVIO_WERROR=OFF -DGVIO_BUILD_TESTS=ON >/dev/null
+  local targets=()
+  for t in "$@"; do targets+=(--target "$t"); done
+  cmake --build "$dir" -j "$JOBS" "${targets[@]}"
+}
+
+# Sanitizer reports end the program with an error (tests fail); known leaks of system libraries
+# that gvio cannot free are suppressed, each with its reason, in tests/sanitizers/.
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1"
+export LSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/lsan.supp:print_suppressions=0"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+
+# The drives too slow to repeat under ASan on every change (./setup.sh sanitize quick skips them).
+QUICK_SANITIZE_EXCLUDE='^(CliGnssFile|CliKalibr|CliLoops|CliLoopsNoRevisit|CliLoopsRepetitive|CliMap|CliMapLoop|CliRosbag|CliRunEndToEnd|CliRunGnss|CliRunThreads|CliTimeOffset|VioDrive|SimEndToEnd|SimWorldRenderTest|SimWorldStyles|SimWorldStylesRender|MappingSim)\.|^FeatureTrackerTest\.TracksPersist'
+
+sanitize() {
+  local exclude="${SANITIZE_EXCLUDE:-}"
+  [ "${1:-}" = quick ] && exclude="$QUICK_SANITIZE_EXCLUDE"
+  build_instrumented build-san address,undefined
+  ctest --test-dir build-san --output-on-failure -j "$JOBS" ${exclude:+-E "$exclude"}
+}
+
+fuzz() {
+  build_instrumented build-san address,undefined gvio_fuzz
+  tests/fuzz/run_fuzzers.sh build-san "${1:-60}" "${@:2}"
+}
+
 install_packages
-build
 case "$mode" in
-  build) ;;
+  build) build ;;
   test)
+    build
     ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS"
     ;;
+  sanitize)
+    sanitize "${2:-}"
+    ;;
+  fuzz)
+    fuzz "${@:2}"
+    ;;
   demo)
+    build
     # Simulate 20 s of the embedded drive (stereo, IMU, SPP GNSS, exact truth), then validate it.
     mkdir -p out/demo
     "$BUILD_DIR/app/gvio" simulate --trajectory assets/demo/drive.tum --seconds 20 --out out/demo/drive --force
@@ -76,7 +127,7 @@ case "$mode" in
       "in out/demo/run, images in out/demo/run/render"
     ;;
   *)
-    echo "usage: ./setup.sh [demo|test|build]" >&2
+    echo "usage: ./setup.sh [demo|test|build|sanitize [quick]|fuzz [SECONDS [TARGET...]]]" >&2
     exit 2
     ;;
 esac

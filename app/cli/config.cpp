@@ -112,8 +112,11 @@ void flatten(const YAML::Node& node, const std::string& prefix,
   }
 }
 
+// Where each key's value came from: the config file's line, or --set (line 0).
+using KeyOrigins = std::map<std::string, std::size_t>;
+
 void applyFile(const std::filesystem::path& file, std::map<std::string, ConfigKey*>& keys,
-               std::vector<std::string>* unknown_keys) {
+               std::vector<std::string>* unknown_keys, KeyOrigins* origins = nullptr) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(file.string());
@@ -138,10 +141,12 @@ void applyFile(const std::filesystem::path& file, std::map<std::string, ConfigKe
     } catch (const InvalidInput& e) {
       throw io::InputError(file, entry.line, e.what());
     }
+    if (origins) (*origins)[key] = entry.line;
   }
 }
 
-void applyOverride(const std::string& assignment, std::map<std::string, ConfigKey*>& keys) {
+void applyOverride(const std::string& assignment, std::map<std::string, ConfigKey*>& keys,
+                   KeyOrigins& origins) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0) {
     throw InvalidInput("--set '" + assignment + "': expected key=value");
@@ -150,6 +155,38 @@ void applyOverride(const std::string& assignment, std::map<std::string, ConfigKe
   const auto it = keys.find(key);
   if (it == keys.end()) throw InvalidInput("--set: unknown config key '" + key + "'");
   it->second->set(std::string_view(assignment).substr(eq + 1));
+  origins[key] = 0;
+}
+
+// The key a validation message is about. The libraries name their own fields ("config:
+// tracker.max_features must be ..."), which is the tail of the dotted key; the key the user set
+// is the one meant.
+const std::string* keyOfMessage(const std::string& message, const KeyOrigins& origins) {
+  const std::string prefix = "config: ";  // also "map config: "
+  const std::size_t at = message.find(prefix);
+  if (at == std::string::npos) return nullptr;
+  const std::size_t begin = at + prefix.size();
+  const std::string field = message.substr(begin, message.find(' ', begin) - begin);
+  for (const auto& [key, origin] : origins) {
+    if (key == field || key.ends_with("." + field)) return &key;
+  }
+  return nullptr;
+}
+
+// A value that passed its own parse but not the configuration's checks: the error names where the
+// user wrote it (the file's line or --set), not only the key.
+[[noreturn]] void rethrowAtOrigin(const InvalidInput& e, const KeyOrigins& origins,
+                                  const std::optional<std::filesystem::path>& file) {
+  const std::string* key = keyOfMessage(e.what(), origins);
+  if (!key) {
+    // A rule over several keys, or a default the file's values conflict with: the file is the
+    // place to look.
+    if (file) throw io::InputError(*file, 0, e.what());
+    throw e;
+  }
+  const std::size_t line = origins.at(*key);
+  if (line > 0 && file) throw io::InputError(*file, line, e.what());
+  throw InvalidInput("--set " + *key + ": " + e.what());
 }
 
 }  // namespace
@@ -340,9 +377,14 @@ AppConfig loadConfig(const ConfigSources& sources, std::vector<std::string>* unk
   auto keys = configKeys(config);
   std::map<std::string, ConfigKey*> by_name;
   for (auto& k : keys) by_name[k.name] = &k;
-  if (sources.file) applyFile(*sources.file, by_name, unknown_keys);
-  for (const auto& assignment : sources.overrides) applyOverride(assignment, by_name);
-  config.validate();
+  KeyOrigins origins;
+  if (sources.file) applyFile(*sources.file, by_name, unknown_keys, &origins);
+  for (const auto& assignment : sources.overrides) applyOverride(assignment, by_name, origins);
+  try {
+    config.validate();
+  } catch (const InvalidInput& e) {
+    rethrowAtOrigin(e, origins, sources.file);
+  }
   return config;
 }
 

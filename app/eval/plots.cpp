@@ -202,9 +202,10 @@ std::vector<std::string> writePlots(const PlotData& data, const std::string& pre
   static constexpr std::array<std::pair<const char*, PlotFn>, 3> kPlots = {
       {{"_trajectory", drawTrajectoryPlot}, {"_error", drawErrorPlot}, {"_axes", drawAxesPlot}}};
   std::vector<std::string> written;
-  for (const auto& [suffix, draw] : kPlots) {
+  for (const auto& plot : kPlots) {
+    const PlotFn draw = plot.second;  // a named copy: clang 14 cannot capture a structured binding
     const auto files = canvas::writePngAndSvg(
-        prefix + suffix,
+        prefix + plot.first,
         [&](cairo_t* cr, double width, double height) { draw(cr, width, height, data); });
     written.insert(written.end(), files.begin(), files.end());
   }

@@ -18,6 +18,7 @@
 
 #include "io/atomic_write.hpp"
 #include "io/input_error.hpp"
+#include "io/pcl_checks.hpp"
 #include "io/quiet_pcl.hpp"
 #include "io/run_dir.hpp"
 
@@ -133,6 +134,11 @@ void checkReadable(const fs::path& file) {
 
 pcl::PCLPointCloud2 readPointCloud2(const fs::path& file) {
   checkReadable(file);
+  if (file.extension() == ".ply") {
+    io::checkPlyFile(file);
+  } else {
+    io::checkPcdFile(file);
+  }
   pcl::PCLPointCloud2 cloud;
   int rc = -1;
   {

@@ -1,6 +1,9 @@
 #include "io/dataset.hpp"
 
+#include <fmt/format.h>
+
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 
 #include "io/comma2k19.hpp"
 #include "io/euroc.hpp"
@@ -110,6 +113,23 @@ Dataset readDataset(const fs::path& path, std::optional<DatasetFormat> format,
     throw InputError(path, 0, "dataset holds no camera frames, IMU samples or GNSS fixes");
   }
   return ds;
+}
+
+void checkFirstImageSizes(const Dataset& ds,
+                          const std::vector<std::filesystem::path>& calibration) {
+  if (ds.frames.empty()) return;
+  for (std::size_t c = 0; c < ds.cameras.size() && c < calibration.size(); ++c) {
+    if (c >= ds.frames.front().image_paths.size()) break;
+    const std::filesystem::path& first = ds.frames.front().image_paths[c];
+    const cv::Mat image = cv::imread(first.string(), cv::IMREAD_GRAYSCALE);
+    const CameraModel& cam = ds.cameras[c];
+    if (!image.empty() && (image.cols != cam.width_px || image.rows != cam.height_px)) {
+      throw InputError(
+          calibration[c], 0,
+          fmt::format("{} is {}x{} but the calibration of {} says {}x{}", first.string(),
+                      image.cols, image.rows, cam.name, cam.width_px, cam.height_px));
+    }
+  }
 }
 
 cv::Mat loadFrameImage(const Dataset& ds, std::size_t frame, std::size_t camera) {

@@ -73,9 +73,21 @@ struct Dataset {
   std::vector<BagTopicUse> bag_topics;            // ROS bags only
 };
 
+// The calibrated image size of each camera against its first image, before any frame is
+// processed: a mismatch is reported against the file the size came from (`calibration[c]` for
+// camera c), naming the image too. An image that does not decode is left to loadFrameImage.
+void checkFirstImageSizes(const Dataset& dataset,
+                          const std::vector<std::filesystem::path>& calibration);
+
 // Frame `frame`'s image of camera `camera` (from its file or the image store), 8-bit grey and
 // size-checked. Throws InputError.
 cv::Mat loadFrameImage(const Dataset& dataset, std::size_t frame, std::size_t camera);
+
+// The calibrated image size of each camera against its first image, before any frame is
+// processed: a mismatch is reported against the file the size came from (`calibration[c]` for
+// camera c), naming the image too. An image that does not decode is left to loadFrameImage.
+void checkFirstImageSizes(const Dataset& dataset,
+                          const std::vector<std::filesystem::path>& calibration);
 // The file's folder or the store's source: what a run groups unreadable images by.
 std::string imageSource(const Dataset& dataset, std::size_t frame, std::size_t camera);
 

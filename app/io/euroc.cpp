@@ -2,12 +2,14 @@
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
+#include <cmath>
 
 #include <fstream>
 #include <map>
 #include <sstream>
 
 #include "io/input_error.hpp"
+#include "io/rotation_check.hpp"
 #include "io/sensor_yaml.hpp"
 #include "io/text.hpp"
 #include "io/trajectory_io.hpp"
@@ -19,8 +21,16 @@ namespace {
 Eigen::Isometry3d yamlTransform(const YAML::Node& root, const fs::path& file) {
   if (!root["T_BS"]) return Eigen::Isometry3d::Identity();
   const auto data = yamlList<double>(root["T_BS"], "data", 16, file);
+  const Eigen::Matrix4d m =
+      Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(data.data());
+  const auto R = calibrationRotation(m.topLeftCorner<3, 3>());
+  if (!R || !m.topRightCorner<3, 1>().allFinite() ||
+      m.row(3) != Eigen::RowVector4d(0.0, 0.0, 0.0, 1.0)) {
+    throw InputError(file, lineOf(root["T_BS"]), "'T_BS' is not a rigid transform");
+  }
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.matrix() = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(data.data());
+  T.linear() = *R;
+  T.translation() = m.topRightCorner<3, 1>();
   return T;
 }
 
@@ -69,13 +79,21 @@ void readImu(const fs::path& dir, Dataset& ds) {
   if (fs::is_regular_file(yaml)) {
     const YAML::Node y = loadSensorYaml(yaml);
     ImuNoise n;
+    // Each density must be stated, finite and positive: the estimator weighs every IMU residual
+    // by it, so the file's own line is named here, not a config key later.
     auto get = [&](const char* key) {
+      if (!y[key]) throw InputError(yaml, 0, fmt::format("missing '{}'", key));
+      const auto line = static_cast<std::size_t>(y[key].Mark().line + 1);
+      double v = 0.0;
       try {
-        return y[key] ? y[key].as<double>() : 0.0;
+        v = y[key].as<double>();
       } catch (const YAML::Exception&) {
-        throw InputError(yaml, static_cast<std::size_t>(y[key].Mark().line + 1),
-                         fmt::format("'{}' must be a number", key));
+        throw InputError(yaml, line, fmt::format("'{}' must be a number", key));
       }
+      if (!std::isfinite(v) || v <= 0.0)
+        throw InputError(yaml, line,
+                         fmt::format("'{}' must be a positive number (got {})", key, v));
+      return v;
     };
     n.gyr_noise_density = get("gyroscope_noise_density");
     n.gyr_random_walk = get("gyroscope_random_walk");
@@ -156,7 +174,8 @@ void readCameras(const fs::path& mav0, const Eigen::Isometry3d& T_BS_imu, Datase
   for (const char* name : {"cam0", "cam1"}) {
     const fs::path dir = mav0 / name;
     if (!fs::is_directory(dir)) break;  // cam1 without cam0 is not a camera setup we know
-    CameraModel cam = readCameraYaml(dir / "sensor.yaml", name);
+    CameraModel cam =
+        readingYaml(dir / "sensor.yaml", [&] { return readCameraYaml(dir / "sensor.yaml", name); });
     cam.T_b_c = T_BS_imu.inverse() * cam.T_b_c;  // body = IMU frame
     ds.cameras.push_back(cam);
     lists.push_back(readCameraList(dir, ds));
@@ -207,12 +226,16 @@ Dataset readEuroc(const fs::path& path, const ReaderConfig& /*config*/) {
   Eigen::Isometry3d T_BS_imu = Eigen::Isometry3d::Identity();
   if (fs::is_directory(mav0 / "imu0")) {
     if (fs::is_regular_file(mav0 / "imu0" / "sensor.yaml")) {
-      T_BS_imu = yamlTransform(loadSensorYaml(mav0 / "imu0" / "sensor.yaml"),
-                               mav0 / "imu0" / "sensor.yaml");
+      const fs::path yaml = mav0 / "imu0" / "sensor.yaml";
+      T_BS_imu = readingYaml(yaml, [&] { return yamlTransform(loadSensorYaml(yaml), yaml); });
     }
-    readImu(mav0 / "imu0", ds);
+    readingYaml(mav0 / "imu0" / "sensor.yaml", [&] { readImu(mav0 / "imu0", ds); });
   }
   readCameras(mav0, T_BS_imu, ds);
+  std::vector<fs::path> calibration;
+  for (std::size_t c = 0; c < ds.cameras.size(); ++c)
+    calibration.push_back(mav0 / fmt::format("cam{}", c) / "sensor.yaml");
+  checkFirstImageSizes(ds, calibration);
   if (fs::is_directory(mav0 / "gnss0")) readGnss(mav0 / "gnss0", ds);
   const fs::path gt = mav0 / "state_groundtruth_estimate0" / "data.csv";
   if (fs::is_regular_file(gt)) {

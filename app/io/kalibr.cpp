@@ -119,45 +119,58 @@ ImuNoise readImuNoise(const YAML::Node& block, const fs::path& file) {
   return n;
 }
 
+// One Kalibr file: a camera chain, an IMU file, or both.
+void readKalibrFile(const fs::path& file, KalibrCalibration& out) {
+  const YAML::Node root = loadSensorYaml(file);
+  bool used = false;
+  std::optional<Eigen::Isometry3d> previous;
+  for (int i = 0; root["cam" + std::to_string(i)]; ++i) {
+    if (!out.cameras.empty() && i == 0) {
+      throw InputError(file, 0, "a second camera chain: give one camchain file");
+    }
+    const std::string name = "cam" + std::to_string(i);
+    const YAML::Node block = root[name];
+    previous = readCamera(block, name, previous, file, out);
+    out.camera_topics.push_back(block["rostopic"] ? scalar(block, "rostopic", file) : "");
+    const double shift =
+        block["timeshift_cam_imu"] ? number(block, "timeshift_cam_imu", file) : 0.0;
+    // Clock offsets are milliseconds; seconds would mean another time scale, and the stamps it
+    // shifts must stay within int64 nanoseconds.
+    if (!(std::abs(shift) <= 1.0)) {
+      throw InputError(file, lineOf(block["timeshift_cam_imu"]),
+                       fmt::format("{}: timeshift_cam_imu {} s is not a camera-IMU clock offset "
+                                   "(expected within +-1 s)",
+                                   name, shift));
+    }
+    if (i == 0) {
+      out.timeshift_cam_imu_s = shift;
+    } else if (std::abs(shift - out.timeshift_cam_imu_s) > 1e-6) {
+      out.warnings.push_back(
+          fmt::format("{}: {} timeshift_cam_imu {} s differs from cam0's {} s; "
+                      "cam0's is used for every camera",
+                      file.string(), name, shift, out.timeshift_cam_imu_s));
+    }
+    used = true;
+  }
+  const YAML::Node imu = root["imu0"] ? root["imu0"] : root;
+  if (imu["accelerometer_noise_density"] || imu["gyroscope_noise_density"]) {
+    out.imu_noise = readImuNoise(imu, file);
+    if (imu["rostopic"]) out.imu_topic = scalar(imu, "rostopic", file);
+    used = true;
+  }
+  if (!used) {
+    throw InputError(file, 0,
+                     "neither a Kalibr camera chain (cam0, cam1, ...) nor an IMU file "
+                     "(accelerometer_noise_density, ...)");
+  }
+}
+
 }  // namespace
 
 KalibrCalibration readKalibr(const std::vector<fs::path>& files) {
   KalibrCalibration out;
   for (const fs::path& file : files) {
-    const YAML::Node root = loadSensorYaml(file);
-    bool used = false;
-    std::optional<Eigen::Isometry3d> previous;
-    for (int i = 0; root["cam" + std::to_string(i)]; ++i) {
-      if (!out.cameras.empty() && i == 0) {
-        throw InputError(file, 0, "a second camera chain: give one camchain file");
-      }
-      const std::string name = "cam" + std::to_string(i);
-      const YAML::Node block = root[name];
-      previous = readCamera(block, name, previous, file, out);
-      out.camera_topics.push_back(block["rostopic"] ? scalar(block, "rostopic", file) : "");
-      const double shift =
-          block["timeshift_cam_imu"] ? number(block, "timeshift_cam_imu", file) : 0.0;
-      if (i == 0) {
-        out.timeshift_cam_imu_s = shift;
-      } else if (std::abs(shift - out.timeshift_cam_imu_s) > 1e-6) {
-        out.warnings.push_back(
-            fmt::format("{}: {} timeshift_cam_imu {} s differs from cam0's {} s; "
-                        "cam0's is used for every camera",
-                        file.string(), name, shift, out.timeshift_cam_imu_s));
-      }
-      used = true;
-    }
-    const YAML::Node imu = root["imu0"] ? root["imu0"] : root;
-    if (imu["accelerometer_noise_density"] || imu["gyroscope_noise_density"]) {
-      out.imu_noise = readImuNoise(imu, file);
-      if (imu["rostopic"]) out.imu_topic = scalar(imu, "rostopic", file);
-      used = true;
-    }
-    if (!used) {
-      throw InputError(file, 0,
-                       "neither a Kalibr camera chain (cam0, cam1, ...) nor an IMU file "
-                       "(accelerometer_noise_density, ...)");
-    }
+    readingYaml(file, [&] { readKalibrFile(file, out); });
   }
   return out;
 }

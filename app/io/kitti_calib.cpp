@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "io/input_error.hpp"
+#include "io/rotation_check.hpp"
 #include "io/text.hpp"
 
 namespace gvio::io {
@@ -18,18 +19,24 @@ Eigen::Isometry3d isometryFrom(const std::vector<double>& R9, const std::vector<
 }
 
 // Rotation matrices in the calibration must be proper rotations; a typo there silently corrupts
-// every projection otherwise.
-void requireRotation(const Eigen::Matrix3d& R, const KittiCalibFile& file, const std::string& key) {
-  const double err = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-  if (err > 1e-3 || R.determinant() <= 0.0) {
-    throw InputError(file.path(), 0, key + " is not a rotation matrix");
+// every projection otherwise. KITTI prints them to 7 digits: they are made exactly orthonormal.
+Eigen::Matrix3d requireRotation(const Eigen::Matrix3d& R, const KittiCalibFile& file,
+                                const std::string& key) {
+  const auto rotation = calibrationRotation(R);
+  if (!rotation) throw InputError(file.path(), 0, key + " is not a rotation matrix");
+  return *rotation;
+}
+
+void requireImageSize(const CameraModel& cam, const KittiCalibFile& file, const std::string& key) {
+  if (cam.width_px < 1 || cam.height_px < 1 || cam.width_px > 100000 || cam.height_px > 100000) {
+    throw InputError(file.path(), 0, key + " is not an image size");
   }
 }
 
 Eigen::Isometry3d readRt(const KittiCalibFile& file, const std::string& r_key,
                          const std::string& t_key) {
-  const Eigen::Isometry3d T = isometryFrom(file.numbers(r_key, 9), file.numbers(t_key, 3));
-  requireRotation(T.linear(), file, r_key);
+  Eigen::Isometry3d T = isometryFrom(file.numbers(r_key, 9), file.numbers(t_key, 3));
+  T.linear() = requireRotation(T.linear(), file, r_key);
   return T;
 }
 
@@ -51,7 +58,11 @@ CameraModel rectifiedCamera(const KittiCalibFile& c2c, int id) {
   Eigen::Isometry3d T_ci_cam0 = Eigen::Isometry3d::Identity();
   T_ci_cam0.linear() =
       Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R_rect.data());
-  requireRotation(T_ci_cam0.linear(), c2c, "R_rect_00");
+  T_ci_cam0.linear() = requireRotation(T_ci_cam0.linear(), c2c, "R_rect_00");
+  if (!(cam.fx > 0.0 && cam.fy > 0.0) || !t.allFinite()) {
+    throw InputError(c2c.path(), 0, fmt::format("P_rect_{:02d} is not a camera matrix", id));
+  }
+  requireImageSize(cam, c2c, fmt::format("S_rect_{:02d}", id));
   T_ci_cam0.pretranslate(t);
   cam.T_b_c = T_ci_cam0;  // completed by the caller with the cam0 <- IMU chain
   return cam;
@@ -68,6 +79,10 @@ CameraModel rawCamera(const KittiCalibFile& c2c, int id) {
   cam.cx = K[2];
   cam.cy = K[5];
   cam.distortion = c2c.numbers(fmt::format("D_{:02d}", id), 5);
+  if (!(cam.fx > 0.0 && cam.fy > 0.0)) {
+    throw InputError(c2c.path(), 0, fmt::format("K_{:02d} is not a camera matrix", id));
+  }
+  requireImageSize(cam, c2c, fmt::format("S_{:02d}", id));
   cam.T_b_c = readRt(c2c, fmt::format("R_{:02d}", id), fmt::format("T_{:02d}", id));
   return cam;
 }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "io/dataset.hpp"
 #include "io/input_error.hpp"
 #include "io/kitti_calib.hpp"
 #include "io/nmea.hpp"
@@ -172,8 +173,10 @@ Dataset readKittiRaw(const fs::path& drive_dir, const ReaderConfig& config) {
     throw InputError(drive_dir, 0, "no image_0X/ nor oxts/ folder: not a KITTI raw drive");
   }
   if (!ids.empty()) {
-    ds.cameras = readKittiCameras(findKittiCalib(drive_dir), ids, ds.variant == "sync");
+    const KittiCalibPaths calib = findKittiCalib(drive_dir);
+    ds.cameras = readKittiCameras(calib, ids, ds.variant == "sync");
     readFrames(drive_dir, ids, ds);
+    checkFirstImageSizes(ds, std::vector<fs::path>(ds.cameras.size(), calib.cam_to_cam));
   }
   if (use_nmea) {
     NmeaLog log = readNmea(nmea, config);

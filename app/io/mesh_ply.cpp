@@ -4,9 +4,12 @@
 #include <pcl/conversions.h>
 #include <pcl/io/ply_io.h>
 #include <pcl/point_types.h>
+#include <algorithm>
+#include <string>
 
 #include "io/atomic_write.hpp"
 #include "io/input_error.hpp"
+#include "io/pcl_checks.hpp"
 #include "io/quiet_pcl.hpp"
 
 namespace gvio::io {
@@ -36,8 +39,29 @@ void writeMeshPly(const std::filesystem::path& file, const TriangleMesh& mesh) {
   moveIntoPlace(tmp, file);
 }
 
+namespace {
+
+// pcl::fromPCLPointCloud2 trusts the blob's layout: a vertex element without float x/y/z, with
+// fields beyond its stride, with no vertices or with less data than it declares would be read out
+// of bounds (found by fuzzing), so the layout is checked first.
+bool hasFloatXyz(const pcl::PCLPointCloud2& cloud) {
+  for (const char* name : {"x", "y", "z"}) {
+    const auto f = std::find_if(cloud.fields.begin(), cloud.fields.end(),
+                                [&](const pcl::PCLPointField& p) { return p.name == name; });
+    if (f == cloud.fields.end() || f->datatype != pcl::PCLPointField::FLOAT32 || f->count < 1 ||
+        std::size_t{f->offset} + 4 > cloud.point_step) {
+      return false;
+    }
+  }
+  const std::size_t n = std::size_t{cloud.width} * cloud.height;
+  return n > 0 && cloud.data.size() >= n * cloud.point_step;
+}
+
+}  // namespace
+
 TriangleMesh readMeshPly(const std::filesystem::path& file) {
   if (!std::filesystem::is_regular_file(file)) throw InputError(file, 0, "file not found");
+  checkPlyFile(file);
   pcl::PolygonMesh pm;
   bool loaded = false;
   try {
@@ -47,6 +71,7 @@ TriangleMesh readMeshPly(const std::filesystem::path& file) {
     loaded = false;
   }
   if (!loaded) throw InputError(file, 0, "not a readable PLY mesh");
+  if (!hasFloatXyz(pm.cloud)) throw InputError(file, 0, "no vertices with float x, y and z");
   pcl::PointCloud<pcl::PointXYZ> cloud;
   pcl::fromPCLPointCloud2(pm.cloud, cloud);
   TriangleMesh mesh;

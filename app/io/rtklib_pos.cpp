@@ -79,7 +79,8 @@ std::int64_t parseTime(const std::vector<std::string_view>& f, const Layout& lay
   } else {
     const std::int64_t week = parseInt64(f[0], at, "GPS week");
     const std::int64_t tow_ns = parseSecondsNs(f[1], at, "GPS seconds of week");
-    if (week < 0 || tow_ns < 0 || tow_ns >= kSecondsPerWeek * kNsPerS) {
+    // Week 10000 is in 2171; int64 nanoseconds end in 2262.
+    if (week < 0 || week > 10000 || tow_ns < 0 || tow_ns >= kSecondsPerWeek * kNsPerS) {
       at.fail("GPS week / seconds of week out of range");
     }
     if (layout.time_system != "GPST") at.fail("week and seconds of week need GPST");

@@ -125,6 +125,8 @@ std::vector<TimeSpan> readOutages(const fs::path& file) {
     j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     throw InputError(file, lineOfByte(text, e.byte), "not valid JSON");
+  } catch (const nlohmann::json::exception& e) {  // e.g. a number too large for a double
+    throw InputError(file, 0, std::string("not valid JSON: ") + e.what());
   }
   if (!j.is_object()) throw InputError(file, 0, "expected a JSON object");
   std::vector<TimeSpan> spans;

@@ -9,11 +9,13 @@
 #include <cstring>
 #include <fstream>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "io/input_error.hpp"
+#include "io/pcl_checks.hpp"
 #include "io/quiet_pcl.hpp"
 #include "io/run_dir.hpp"
 
@@ -88,98 +90,11 @@ std::optional<FieldReader> findField(const pcl::PCLPointCloud2& cloud, const std
   return std::nullopt;
 }
 
-struct PcdHeader {
-  std::vector<std::string> fields;
-  std::vector<std::size_t> size, count;
-  std::vector<char> type;
-  std::size_t width = 0, height = 0;
-  std::optional<std::size_t> points;
-};
-
-template <typename T>
-std::vector<T> readAll(std::istringstream& in) {
-  std::vector<T> v;
-  T x;
-  while (in >> x) v.push_back(x);
-  return v;
-}
-
-// Checks the header's consistency and that the data section is as long as it says; returns the
-// number of points. Line numbers in errors are the header's.
-std::size_t checkPcdHeader(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file, 0, "cannot open for reading");
-  PcdHeader h;
-  std::string line;
-  for (std::size_t n = 1; n <= 64 && std::getline(in, line); ++n) {
-    std::istringstream ss(line);
-    std::string key;
-    ss >> key;
-    if (key.empty() || key[0] == '#' || key == "VERSION" || key == "VIEWPOINT") continue;
-    bool ok = true;
-    if (key == "FIELDS") {
-      h.fields = readAll<std::string>(ss);
-    } else if (key == "SIZE") {
-      h.size = readAll<std::size_t>(ss);
-    } else if (key == "COUNT") {
-      h.count = readAll<std::size_t>(ss);
-    } else if (key == "TYPE") {
-      h.type = readAll<char>(ss);
-    } else if (key == "WIDTH") {
-      ok = static_cast<bool>(ss >> h.width);
-    } else if (key == "HEIGHT") {
-      ok = static_cast<bool>(ss >> h.height);
-    } else if (key == "POINTS") {
-      h.points.emplace();
-      ok = static_cast<bool>(ss >> *h.points);
-    } else if (key != "DATA") {
-      throw InputError(file, n, "not a PCD header line: '" + line.substr(0, 40) + "'");
-    }
-    if (!ok) throw InputError(file, n, "bad PCD header line '" + line + "'");
-    if (key != "DATA") continue;
-    std::string data;
-    ss >> data;
-    if (h.count.empty()) h.count.assign(h.fields.size(), 1);
-    const std::size_t k = h.fields.size();
-    bool valid = k > 0 && h.size.size() == k && h.type.size() == k && h.count.size() == k &&
-                 h.points && *h.points == h.width * h.height;
-    std::size_t step = 0;
-    for (std::size_t i = 0; valid && i < k; ++i) {
-      const std::size_t s = h.size[i];
-      valid = (s == 1 || s == 2 || s == 4 || s == 8) && h.count[i] >= 1 &&
-              (h.type[i] == 'I' || h.type[i] == 'U' || (h.type[i] == 'F' && s >= 4));
-      step += s * h.count[i];
-    }
-    if (!valid) {
-      throw InputError(file, n,
-                       "PCD header: FIELDS, SIZE, TYPE, COUNT, WIDTH x HEIGHT, POINTS disagree");
-    }
-    const std::size_t points = h.width * h.height;
-    const auto data_at = static_cast<std::size_t>(in.tellg());
-    const auto bytes = static_cast<std::size_t>(fs::file_size(file));
-    const std::size_t left = bytes > data_at ? bytes - data_at : 0;
-    if (data == "binary") {
-      valid = left >= points * step;
-    } else if (data == "binary_compressed") {
-      std::uint32_t sizes[2] = {0, 0};  // compressed, uncompressed
-      in.read(reinterpret_cast<char*>(sizes), sizeof sizes);
-      valid = points == 0 ||
-              (in && sizes[0] <= left - std::min(left, sizeof sizes) && sizes[1] == points * step);
-    } else if (data != "ascii") {
-      throw InputError(file, n,
-                       "PCD DATA '" + data + "': expected ascii, binary or binary_compressed");
-    }
-    if (!valid) throw InputError(file, 0, "PCD data is shorter than its header says");
-    return points;
-  }
-  throw InputError(file, 0, "not a PCD file (no DATA line in its header)");
-}
-
 }  // namespace
 
 MapCloud readMapCloud(const fs::path& file) {
   if (!fs::is_regular_file(file)) throw InputError(file, 0, "file not found");
-  if (checkPcdHeader(file) == 0) return {};  // an empty map: nothing for PCL to read
+  if (checkPcdFile(file) == 0) return {};  // an empty map: nothing for PCL to read
   pcl::PCLPointCloud2 cloud;
   bool loaded = false;
   try {

@@ -17,6 +17,17 @@ namespace gvio::io {
 // that directive is dropped before parsing.
 YAML::Node loadSensorYaml(const std::filesystem::path& file);
 
+// read(): reads a parsed sensor file. yaml-cpp throws its own exception for a node of the wrong
+// kind (a scalar where a mapping goes); that becomes an InputError naming the file and line.
+template <typename Fn>
+auto readingYaml(const std::filesystem::path& file, Fn&& read) {
+  try {
+    return read();
+  } catch (const YAML::Exception& e) {
+    throw InputError(file, e.mark.is_null() ? 0 : static_cast<std::size_t>(e.mark.line + 1), e.msg);
+  }
+}
+
 // The line of `node` for error messages (0 when the node is absent).
 std::size_t lineOf(const YAML::Node& node);
 

@@ -10,10 +10,34 @@
 
 namespace gvio::io {
 
+namespace {
+
+// The user sees one line: control characters quoted from the input (a parser's "unknown escape
+// character" names the byte it met) are written as escapes.
+std::string oneLine(const std::string& message) {
+  std::string out;
+  out.reserve(message.size());
+  for (const char c : message) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte == '\n') {
+      out += "\\n";
+    } else if (byte == '\r') {
+      out += "\\r";
+    } else if (byte < 0x20 || byte == 0x7F) {
+      out += fmt::format("\\x{:02x}", byte);
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 InputError::InputError(const std::filesystem::path& file, std::size_t line,
                        const std::string& message)
     : InvalidInput(file.string() + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " +
-                   message) {}
+                   oneLine(message)) {}
 
 LineReader::LineReader(const std::filesystem::path& file) : path_(file) {
   std::error_code ec;
@@ -203,6 +227,9 @@ bool kittiTimestampToNs(std::string_view text, std::int64_t& t_ns) {
   if (month < 1 || month > 12 || day < 1 || day > 31 || hour > 23 || minute > 59 || second > 60) {
     return false;
   }
+  // int64 nanoseconds since 1970 span 1677-09-21 to 2262-04-11: a year outside would overflow,
+  // and so could a time-zone shift near the ends. Recorded drives lie well inside.
+  if (year < 1900 || year > 2200) return false;
   std::int64_t frac_ns = 0;
   if (text.size() > 19) {
     if (text[19] != '.') return false;

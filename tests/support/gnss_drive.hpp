@@ -65,17 +65,24 @@ inline GnssDrive makeGnssDrive(double outage_t0_s = -1, double outage_t1_s = -1,
     d.vio.poses.push_back(T_vio);
     const double t_s = k * dt;
     if (k % 10 != 0 || (t_s >= outage_t0_s && t_s <= outage_t1_s)) continue;
-    Eigen::Vector3d p =
-        T * d.lever + Eigen::Vector3d(1.5 * n01(rng), 1.5 * n01(rng), 3.0 * n01(rng));
+    // Draws are sequenced (unsequenced arguments made the drive depend on the compiler), in the
+    // order GCC evaluated them, so the drive, and the bounds tuned on it, stay as they were.
+    const double noise_u = 3.0 * n01(rng), noise_n = 1.5 * n01(rng), noise_e = 1.5 * n01(rng);
+    Eigen::Vector3d p = T * d.lever + Eigen::Vector3d(noise_e, noise_n, noise_u);
     // b_{k+1} = phi b_k + w, var(w) = sigma^2 (1 - phi^2) (fixes 1 s apart).
     const double phi = std::exp(-1.0 / bias_tau_s);
+    const double w_u = n_bias(rng_bias), w_n = n_bias(rng_bias), w_e = n_bias(rng_bias);
     bias = (bias_fixes == 0 ? 0.0 : phi) * bias +
            bias_m * std::sqrt(bias_fixes == 0 ? 1.0 : 1.0 - phi * phi) *
-               Eigen::Vector3d(n_bias(rng_bias), n_bias(rng_bias), n_bias(rng_bias));
+               Eigen::Vector3d(w_e, w_n, w_u);
     ++bias_fixes;
     p += bias;
     const bool bad = u01(rng) < 0.02;
-    if (bad) p += Eigen::Vector3d(n01(rng), n01(rng), 0.2).normalized() * (15.0 + 15.0 * u01(rng));
+    if (bad) {
+      const double size_m = 15.0 + 15.0 * u01(rng);
+      const double dn = n01(rng), de = n01(rng);
+      p += Eigen::Vector3d(de, dn, 0.2).normalized() * size_m;
+    }
     const fusion::Lla lla = d.enu.toLla(p);
     GnssFix f;
     f.t_ns = t_ns;

@@ -93,6 +93,23 @@ TEST(Config, ValidateRejectsOutOfRange) {
   EXPECT_THAT(errorOf({std::nullopt, {"dataset.gap_factor=nan"}}), HasSubstr("finite"));
 }
 
+// A value that parses but fails validation is reported where it was written: the file's line, or
+// the --set that gave it (a later --set wins over the file, and so does its error).
+TEST(Config, ValidationErrorsNameWhereTheValueCameFrom) {
+  test::TempDir dir("config");
+  const fs::path file = dir.path() / "c.yaml";
+  test::writeText(file, "dataset:\n  gap_factor: 3\nimu:\n  gyr_noise_density: -1\n");
+  const std::string from_file = errorOf({file, {}});
+  EXPECT_THAT(from_file, HasSubstr(file.string() + ":4: "));
+  EXPECT_THAT(from_file, HasSubstr("imu.gyr_noise_density"));
+  const std::string from_set = errorOf({file, {"imu.gyr_noise_density=-2"}});
+  EXPECT_THAT(from_set, HasSubstr("--set imu.gyr_noise_density: "));
+  EXPECT_THAT(from_set, testing::Not(HasSubstr(file.string())));
+  // The libraries name their own fields (tracker.max_features): the dotted key is found.
+  test::writeText(file, "vio:\n  tracker:\n    max_features: 0\n");
+  EXPECT_THAT(errorOf({file, {}}), HasSubstr(file.string() + ":3: "));
+}
+
 TEST(Config, OverrideErrors) {
   EXPECT_THAT(errorOf({std::nullopt, {"dataset.nope=1"}}),
               HasSubstr("unknown config key 'dataset.nope'"));

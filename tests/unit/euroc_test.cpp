@@ -209,6 +209,19 @@ TEST_F(EurocTest, ImuTimestampsNotIncreasing) {
   EXPECT_TRUE(names(error(), imuCsv(), 7, "duplicate timestamp"));
 }
 
+// The IMU noise is checked where it is read, so the error names sensor.yaml's line (not a config
+// key the user never wrote).
+TEST_F(EurocTest, ImuNoiseMustBeStatedAndPositive) {
+  writeImu(10);
+  const fs::path yaml = mav0() / "imu0" / "sensor.yaml";
+  test::replaceLine(yaml, 5, "gyroscope_random_walk: -2.0e-05");
+  EXPECT_TRUE(names(error(), yaml, 5, "'gyroscope_random_walk' must be a positive number"));
+  test::replaceLine(yaml, 5, "gyroscope_random_walk: .nan");
+  EXPECT_TRUE(names(error(), yaml, 5, "must be a positive number"));
+  test::replaceLine(yaml, 5, "# none");
+  EXPECT_TRUE(names(error(), yaml, 0, "missing 'gyroscope_random_walk'"));
+}
+
 TEST_F(EurocTest, CameraWithoutSensorYaml) {
   writeImu(10);
   writeCamera("cam0", 2);

@@ -277,9 +277,9 @@ TEST(MappingBuilder, DepthOnlyOnceTheCameraMovedOrTurnedEnough) {
   MapConfig config;  // the defaults: 1.5 m or 10 deg since the last keyframe with depth
   const CameraModel cam = camera();
   MapBuilder builder(config, cam, 0.54);
-  const auto [left, right] = planePair(cam);
+  const auto pair = planePair(cam);  // not a structured binding: clang 14 cannot capture one
   const auto depth = [&](std::int64_t t, const Eigen::Isometry3d& T_w_b) {
-    return builder.addKeyframe(t, T_w_b, left, right, {}).dense_points > 0;
+    return builder.addKeyframe(t, T_w_b, pair.first, pair.second, {}).dense_points > 0;
   };
   EXPECT_TRUE(depth(1, pose(0, {0, 0, 0})));        // the first keyframe
   EXPECT_FALSE(depth(2, pose(0, {0.8, 0, 0})));     // 0.8 m
@@ -296,7 +296,8 @@ TEST(MappingBuilder, DepthOnlyOnceTheCameraMovedOrTurnedEnough) {
   config.dense.min_rotation_deg = 0.0;
   MapBuilder every(config, cam, 0.54);
   for (std::int64_t t = 1; t <= 3; ++t) {
-    EXPECT_GT(every.addKeyframe(t, pose(0, {0, 0, 0}), left, right, {}).dense_points, 0u);
+    EXPECT_GT(every.addKeyframe(t, pose(0, {0, 0, 0}), pair.first, pair.second, {}).dense_points,
+              0u);
   }
   config.dense.min_spacing_m = -1.0;
   EXPECT_THROW(config.validate(), InvalidInput);

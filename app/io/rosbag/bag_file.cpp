@@ -1,5 +1,7 @@
 #include "io/rosbag/bag_file.hpp"
 
+#include "io/rosbag/record_scan.hpp"
+
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/CompressedImage.h>
@@ -122,6 +124,7 @@ struct BagReader::Impl {
 };
 
 BagReader::BagReader(const std::string& path) : impl_(std::make_unique<Impl>()) {
+  checkBagRecords(path);
   guarded("cannot read the bag (truncated or damaged?)", [&] {
     impl_->bag.open(path, rosbag::bagmode::Read);
     rosbag::View all(impl_->bag);

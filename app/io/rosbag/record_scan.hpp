@@ -1,0 +1,16 @@
+#pragma once
+// A structural check of a ROS bag (format 2.0) before librosbag_storage opens it: every top-level
+// record's header and data must lie inside the file, and a chunk's declared size must be
+// plausible. librosbag_storage allocates whatever a length field says (a damaged 4-byte field
+// asked it for 2.3 GB; found by fuzzing), so such bags are refused here with the byte offset.
+// http://wiki.ros.org/Bags/Format/2.0
+#include <string>
+
+namespace gvio::io::bag {
+
+// Throws BagError (bag_file.hpp) for a record that overruns the file, a malformed record header,
+// or a chunk that declares more than 1 GiB uncompressed (or, uncompressed, a size other than its
+// data). Files of other format versions are left to the library.
+void checkBagRecords(const std::string& path);
+
+}  // namespace gvio::io::bag
