@@ -1,5 +1,7 @@
 #include "io/mesh_ply.hpp"
 
+#include <fmt/format.h>
+
 #include <pcl/PolygonMesh.h>
 #include <pcl/conversions.h>
 #include <pcl/io/ply_io.h>
@@ -75,7 +77,12 @@ TriangleMesh readMeshPly(const std::filesystem::path& file) {
   pcl::PointCloud<pcl::PointXYZ> cloud;
   pcl::fromPCLPointCloud2(pm.cloud, cloud);
   TriangleMesh mesh;
-  for (const auto& p : cloud) mesh.vertices.emplace_back(p.x, p.y, p.z);
+  for (const auto& p : cloud) {
+    mesh.vertices.emplace_back(p.x, p.y, p.z);
+    if (!mesh.vertices.back().allFinite()) {
+      throw InputError(file, 0, fmt::format("vertex {} is not finite", mesh.vertices.size() - 1));
+    }
+  }
   for (const auto& poly : pm.polygons) {
     if (poly.vertices.size() != 3) throw InputError(file, 0, "faces must be triangles");
     std::array<std::uint32_t, 3> tri{};
