@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <fstream>
+#include <numeric>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -33,10 +34,13 @@ std::vector<T> readAll(std::istringstream& in) {
   return v;
 }
 
-std::size_t sumOf(const std::vector<std::size_t>& v) {
-  std::size_t total = 0;
-  for (const std::size_t x : v) total += x;
-  return total;
+// A header line of printable ASCII and tabs (and CRs where `cr_allowed`): both readers of PCL
+// misbehave on control bytes in their headers.
+bool printable(const std::string& line, bool cr_allowed) {
+  return std::none_of(line.begin(), line.end(), [&](char c) {
+    const auto b = static_cast<unsigned char>(c);
+    return (b < 0x20 && c != '\t' && !(cr_allowed && c == '\r')) || b > 0x7E;
+  });
 }
 
 // ASCII data: `points` rows of `values` numbers each (blank lines aside).
@@ -53,8 +57,6 @@ bool asciiRowsFit(std::istream& in, std::size_t points, std::size_t values) {
   return rows == points;
 }
 
-// Checks the header's consistency and that the data section is as long as it says; returns the
-// number of points. Line numbers in errors are the header's.
 }  // namespace
 
 std::size_t checkPcdFile(const fs::path& file) {
@@ -66,10 +68,7 @@ std::size_t checkPcdFile(const fs::path& file) {
   for (std::size_t n = 1; n <= 64 && std::getline(in, line); ++n) {
     // PCL's header parser misbehaves on control bytes and repeated keys (a use after free, found
     // by fuzzing): a header is printable text with each key once.
-    if (std::any_of(line.begin(), line.end(), [](char c) {
-          const auto b = static_cast<unsigned char>(c);
-          return (b < 0x20 && c != '\t' && c != '\r') || b > 0x7E;
-        })) {
+    if (!printable(line, true)) {
       throw InputError(file, n, "PCD header line with a control or non-ASCII byte");
     }
     std::istringstream ss(line);
@@ -128,7 +127,8 @@ std::size_t checkPcdFile(const fs::path& file) {
       throw InputError(file, n, "PCD header declares an impossible number or size of points");
     }
     if (data == "ascii") {
-      valid = asciiRowsFit(in, points, k == 0 ? 0 : sumOf(h.count));
+      valid =
+          asciiRowsFit(in, points, std::accumulate(h.count.begin(), h.count.end(), std::size_t{0}));
     } else if (data == "binary") {
       valid = left >= points * step;
     } else if (data == "binary_compressed") {
@@ -136,7 +136,7 @@ std::size_t checkPcdFile(const fs::path& file) {
       in.read(reinterpret_cast<char*>(sizes), sizeof sizes);
       valid = points == 0 ||
               (in && sizes[0] <= left - std::min(left, sizeof sizes) && sizes[1] == points * step);
-    } else if (data != "ascii") {
+    } else {
       throw InputError(file, n,
                        "PCD DATA '" + data + "': expected ascii, binary or binary_compressed");
     }
@@ -153,13 +153,6 @@ bool isPlyType(const std::string& t) {
       "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
       "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
   return kTypes.count(t) > 0;
-}
-
-bool printable(const std::string& line) {
-  return std::none_of(line.begin(), line.end(), [](char c) {
-    const auto b = static_cast<unsigned char>(c);
-    return (b < 0x20 && c != '\t') || b > 0x7E;
-  });
 }
 
 }  // namespace
@@ -179,7 +172,7 @@ void checkPlyFile(const fs::path& file) {
   bool format = false;
   for (std::size_t n = 2; n <= 10000 && next(); ++n) {
     auto bad = [&](const std::string& what) { throw InputError(file, n, "PLY header: " + what); };
-    if (!printable(line)) bad("a control or non-ASCII byte");
+    if (!printable(line, false)) bad("a control or non-ASCII byte");
     std::istringstream words(line);
     std::string key;
     words >> key;

@@ -5,11 +5,11 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
-#include <sstream>
 #include <system_error>
 
 #include "fuzz/targets_list.hpp"
 #include "odometry/error.hpp"
+#include "support/fixtures.hpp"
 
 namespace gvio::fuzz {
 
@@ -109,10 +109,7 @@ Outcome runInput(const Target& target, std::string_view input) {
 std::string seedOf(const Target& target) {
   const fs::path dir = workspace(target);
   target.prepare(dir);  // the fuzzed file may hold an earlier input
-  std::ifstream in(dir / target.file, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
+  return test::readText(dir / target.file);
 }
 
 std::string toString(Verdict verdict) {

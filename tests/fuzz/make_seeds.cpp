@@ -5,9 +5,9 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 
 #include "fuzz/harness.hpp"
+#include "support/fixtures.hpp"
 
 int main(int argc, char** argv) {
   if (argc != 2) {
@@ -18,9 +18,8 @@ int main(int argc, char** argv) {
   const std::filesystem::path corpus(argv[1]);
   for (const auto& target : gvio::fuzz::targets()) {
     const std::filesystem::path dir = corpus / target.name;
-    std::filesystem::create_directories(dir);
     const std::string seed = gvio::fuzz::seedOf(target);
-    std::ofstream(dir / "seed", std::ios::binary) << seed;
+    gvio::test::writeText(dir / "seed", seed);
     std::printf("%-24s %6zu bytes\n", target.name.c_str(), seed.size());
   }
   return 0;

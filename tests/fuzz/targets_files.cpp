@@ -29,11 +29,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-void write(const fs::path& file, const std::string& text) {
-  fs::create_directories(file.parent_path());
-  std::ofstream(file, std::ios::binary) << text;
-}
-
 // The whole dataset as `gvio run` opens it, and every frame's images as the run loads them.
 void readWholeDataset(const fs::path& dataset, std::vector<fs::path> calib_files = {}) {
   io::DatasetSources sources;
@@ -84,26 +79,27 @@ constexpr std::int64_t kT0 = 1'403'715'273'262'142'976;
 void prepareEuroc(const fs::path& dir) {
   const fs::path mav0 = dir / "mav0";
   fs::remove_all(mav0);
-  write(mav0 / "imu0" / "sensor.yaml",
-        "%YAML:1.0\nsensor_type: imu\nrate_hz: 200\n"
-        "T_BS:\n  cols: 4\n  rows: 4\n  data: [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0,\n"
-        "         0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]\n"
-        "gyroscope_noise_density: 1.5e-04\ngyroscope_random_walk: 2.0e-05\n"
-        "accelerometer_noise_density: 2.5e-3\naccelerometer_random_walk: 3.5e-3\n");
+  test::writeText(mav0 / "imu0" / "sensor.yaml",
+                  "%YAML:1.0\nsensor_type: imu\nrate_hz: 200\n"
+                  "T_BS:\n  cols: 4\n  rows: 4\n  data: [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0,\n"
+                  "         0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]\n"
+                  "gyroscope_noise_density: 1.5e-04\ngyroscope_random_walk: 2.0e-05\n"
+                  "accelerometer_noise_density: 2.5e-3\naccelerometer_random_walk: 3.5e-3\n");
   std::string imu = "#timestamp [ns],w_x,w_y,w_z,a_x,a_y,a_z\n";
   for (int i = 0; i < 24; ++i)
     imu += fmt::format("{},0.01,-0.02,0.03,0.1,0.2,9.81\n", kT0 + i * 5'000'000LL);
-  write(mav0 / "imu0" / "data.csv", imu);
+  test::writeText(mav0 / "imu0" / "data.csv", imu);
   for (const char* cam : {"cam0", "cam1"}) {
     const bool right = std::string(cam) == "cam1";
-    write(mav0 / cam / "sensor.yaml",
-          fmt::format("%YAML:1.0\nsensor_type: camera\nrate_hz: 20\nresolution: [32, 16]\n"
-                      "T_BS:\n  cols: 4\n  rows: 4\n  data: [0.0, 0.0, 1.0, 0.0, -1.0, 0.0, 0.0, "
-                      "{},\n         0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]\n"
-                      "camera_model: pinhole\nintrinsics: [20.0, 21.0, 16.0, 8.0]\n"
-                      "distortion_model: radial-tangential\n"
-                      "distortion_coefficients: [0.01, -0.002, 0.0001, 0.0002]\n",
-                      right ? "-0.11" : "0.0"));
+    test::writeText(
+        mav0 / cam / "sensor.yaml",
+        fmt::format("%YAML:1.0\nsensor_type: camera\nrate_hz: 20\nresolution: [32, 16]\n"
+                    "T_BS:\n  cols: 4\n  rows: 4\n  data: [0.0, 0.0, 1.0, 0.0, -1.0, 0.0, 0.0, "
+                    "{},\n         0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]\n"
+                    "camera_model: pinhole\nintrinsics: [20.0, 21.0, 16.0, 8.0]\n"
+                    "distortion_model: radial-tangential\n"
+                    "distortion_coefficients: [0.01, -0.002, 0.0001, 0.0002]\n",
+                    right ? "-0.11" : "0.0"));
     std::string csv = "#timestamp [ns],filename\n";
     for (int i = 0; i < 2; ++i) {
       const std::int64_t t = kT0 + i * 50'000'000LL;
@@ -113,19 +109,19 @@ void prepareEuroc(const fs::path& dir) {
       cv::randu(image, 0, 255);
       cv::imwrite((mav0 / cam / "data" / fmt::format("{}.png", t)).string(), image);
     }
-    write(mav0 / cam / "data.csv", csv);
+    test::writeText(mav0 / cam / "data.csv", csv);
   }
-  write(mav0 / "gnss0" / "data.csv",
-        fmt::format("#timestamp [ns],lat [deg],lon [deg],h [m],sigma_h [m],sigma_v [m]\n"
-                    "{},47.3667,8.55,500.0,1.5,3.0\n{},47.3668,8.5501,500.5,1.2,2.5\n",
-                    kT0, kT0 + 100'000'000LL));
+  test::writeText(mav0 / "gnss0" / "data.csv",
+                  fmt::format("#timestamp [ns],lat [deg],lon [deg],h [m],sigma_h [m],sigma_v [m]\n"
+                              "{},47.3667,8.55,500.0,1.5,3.0\n{},47.3668,8.5501,500.5,1.2,2.5\n",
+                              kT0, kT0 + 100'000'000LL));
   std::string gt =
       "#timestamp,p_x,p_y,p_z,q_w,q_x,q_y,q_z,v_x,v_y,v_z,b_w_x,b_w_y,b_w_z,b_a_x,"
       "b_a_y,b_a_z\n";
   for (int i = 0; i < 3; ++i)
     gt += fmt::format("{},{},0.5,1.0,1.0,0.0,0.0,0.0,1.0,0,0,0,0,0,0,0,0\n", kT0 + i * 50'000'000LL,
                       0.05 * i);
-  write(mav0 / "state_groundtruth_estimate0" / "data.csv", gt);
+  test::writeText(mav0 / "state_groundtruth_estimate0" / "data.csv", gt);
 }
 
 Target euroc(std::string name, const std::string& file) {
@@ -138,15 +134,16 @@ void prepareComma(const fs::path& dir) {
   std::string imu = "#t_boot_s,ax_fwd,ay_right,az_down,gx_fwd,gy_right,gz_down\n";
   for (int i = 0; i < 20; ++i)
     imu += fmt::format("{:.9f},0.1,0.2,-9.81,0.001,0.002,0.003\n", 100.0 + i * 0.01);
-  write(dir / "comma" / "csv" / "imu.csv", imu);
-  write(dir / "comma" / "csv" / "gnss_ublox_fix.csv",
-        "#t_boot_s,lat_deg,lon_deg,speed_mps,utc_timestamp,alt_m,bearing_deg\n"
-        "100.000000000,37.720000000,-122.470000000,10.0,1533226488299,30.000,0.0\n"
-        "100.100000000,37.720009000,-122.470000000,10.0,1533226488399,30.000,0.0\n");
-  write(dir / "comma" / "csv" / "global_pose_gt.csv",
-        "#t_boot_s,gps_week,gps_tow_s,ecef_x,ecef_y,ecef_z,q0,q1,q2,q3\n"
-        "100.000000000,2012,404106.0,-2708470.391,-4260545.476,3881200.134,0.5,0.5,-0.5,0.5\n"
-        "100.050000000,2012,404106.05,-2708470.091,-4260545.276,3881200.534,0.5,0.5,-0.5,0.5\n");
+  test::writeText(dir / "comma" / "csv" / "imu.csv", imu);
+  test::writeText(dir / "comma" / "csv" / "gnss_ublox_fix.csv",
+                  "#t_boot_s,lat_deg,lon_deg,speed_mps,utc_timestamp,alt_m,bearing_deg\n"
+                  "100.000000000,37.720000000,-122.470000000,10.0,1533226488299,30.000,0.0\n"
+                  "100.100000000,37.720009000,-122.470000000,10.0,1533226488399,30.000,0.0\n");
+  test::writeText(
+      dir / "comma" / "csv" / "global_pose_gt.csv",
+      "#t_boot_s,gps_week,gps_tow_s,ecef_x,ecef_y,ecef_z,q0,q1,q2,q3\n"
+      "100.000000000,2012,404106.0,-2708470.391,-4260545.476,3881200.134,0.5,0.5,-0.5,0.5\n"
+      "100.050000000,2012,404106.05,-2708470.091,-4260545.276,3881200.534,0.5,0.5,-0.5,0.5\n");
 }
 
 Target comma(std::string name, const std::string& file) {
@@ -184,8 +181,8 @@ void prepareBag(const fs::path& dir) {
   fix.covariance_type = 2;
   bag.write("/gnss/fix", fix);
   bag.close();
-  write(dir / "camchain.yaml", smallCamchainYaml());
-  write(dir / "imu.yaml", io::kalibrImuYaml(ImuNoise{}, 100.0, "/imu0"));
+  test::writeText(dir / "camchain.yaml", smallCamchainYaml());
+  test::writeText(dir / "imu.yaml", io::kalibrImuYaml(ImuNoise{}, 100.0, "/imu0"));
 }
 
 void readBag(const fs::path& d) {
@@ -222,15 +219,15 @@ void readRosImage(const fs::path& d) {
 void prepareRosImage(const fs::path& dir) {
   std::string bytes = {0, 4, 3, 4, 0};
   for (int i = 0; i < 12; ++i) bytes.push_back(static_cast<char>(20 * i));
-  write(dir / "message.bin", bytes);
+  test::writeText(dir / "message.bin", bytes);
 }
 
 void prepareMaps(const fs::path& dir) {
-  write(dir / "map.pcd",
-        "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n"
-        "FIELDS x y z intensity source\nSIZE 4 4 4 4 1\nTYPE F F F F U\nCOUNT 1 1 1 1 1\n"
-        "WIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n"
-        "1.0 2.0 0.5 120 0\n1.5 2.0 0.5 90 1\n-3.25 7.0 1.75 255 1\n");
+  test::writeText(dir / "map.pcd",
+                  "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n"
+                  "FIELDS x y z intensity source\nSIZE 4 4 4 4 1\nTYPE F F F F U\nCOUNT 1 1 1 1 1\n"
+                  "WIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n"
+                  "1.0 2.0 0.5 120 0\n1.5 2.0 0.5 90 1\n-3.25 7.0 1.75 255 1\n");
   octomap::OcTree tree(0.2);
   octomap::ColorOcTree color(0.2);
   for (int i = 0; i < 5; ++i) {

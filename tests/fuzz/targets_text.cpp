@@ -6,7 +6,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -24,6 +23,7 @@
 #include "io/rtklib_pos.hpp"
 #include "io/run_dir.hpp"
 #include "io/trajectory_io.hpp"
+#include "support/fixtures.hpp"
 
 namespace gvio::fuzz {
 
@@ -33,18 +33,14 @@ using io::TrajectoryFormat;
 
 namespace {
 
-void write(const fs::path& file, const std::string& text) {
-  fs::create_directories(file.parent_path());
-  std::ofstream(file, std::ios::binary) << text;
-}
-
 // A file of its own: prepare() writes `seed` as `name`.
 Target plain(std::string name, std::string file, std::string seed,
              std::function<void(const fs::path&)> read) {
   std::string path = file;
-  return Target{std::move(name), std::move(file),
-                [seed = std::move(seed), path](const fs::path& dir) { write(dir / path, seed); },
-                std::move(read), ""};
+  return Target{
+      std::move(name), std::move(file),
+      [seed = std::move(seed), path](const fs::path& dir) { test::writeText(dir / path, seed); },
+      std::move(read), ""};
 }
 
 // A 3-pose trajectory: stamps, then positions and unit quaternions.
@@ -66,11 +62,9 @@ std::string trajectoryText(TrajectoryFormat format) {
   if (format == TrajectoryFormat::kTum) io::writeTum(tmp, t);
   if (format == TrajectoryFormat::kKitti) io::writeKitti(tmp, t);
   if (format == TrajectoryFormat::kEuroc) io::writeEurocCsv(tmp, t);
-  std::ifstream in(tmp);
-  std::ostringstream s;
-  s << in.rdbuf();
+  std::string text = test::readText(tmp);
   fs::remove(tmp);
-  return s.str();
+  return text;
 }
 
 // Reads as `gvio eval` does (stamps as given) and as the datasets do (strictly increasing).

@@ -4,23 +4,22 @@
 #include <gtest/gtest.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "fuzz/harness.hpp"
+#include "support/fixtures.hpp"
 
 namespace gvio::fuzz {
+
+// Verdicts print by name in failures.
+void PrintTo(Verdict verdict, std::ostream* os) {
+  *os << toString(verdict);
+}
+
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string bytesOf(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 std::vector<fs::path> inputsIn(const fs::path& dir) {
   std::vector<fs::path> files;
@@ -50,7 +49,7 @@ TEST_P(FuzzTarget, CommittedInputsAreReadOrRefusedWithTheFileNamed) {
   auto inputs = inputsIn(fs::path(GVIO_FUZZ_REGRESSIONS_DIR) / GetParam());
   inputs.insert(inputs.end(), corpus.begin(), corpus.end());
   for (const fs::path& file : inputs) {
-    const Outcome o = runInput(target(), bytesOf(file));
+    const Outcome o = runInput(target(), test::readText(file));
     EXPECT_NE(o.verdict, Verdict::kBug) << file << ": " << o.message;
   }
 }
