@@ -1,5 +1,7 @@
 #include "fusion/gnss_fusion.hpp"
 
+#include "fusion/alignment_consensus.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -90,7 +92,11 @@ struct GnssFusion::Impl {
 
   void processFix(const GnssFix& fix);
   void align(const Pair& pair);
-  [[nodiscard]] bool residualsConsistent(const Eigen::Isometry3d& T_enu_w) const;
+  [[nodiscard]] bool residualsConsistent(const Eigen::Isometry3d& T_enu_w,
+                                         const std::vector<bool>& use) const;
+  [[nodiscard]] std::optional<Eigen::Isometry3d> registration(const std::vector<bool>& use) const;
+  [[nodiscard]] std::optional<std::vector<bool>> registrationPairs(
+      const Eigen::Isometry3d& T_ls) const;
   bool fuseGraph(const Pair& pair);
   bool fuseKf(const Pair& pair);
   Eigen::Isometry3d fusedPose(std::int64_t t_ns, const Eigen::Isometry3d& T_w_b) const;
@@ -152,41 +158,90 @@ void GnssFusion::Impl::noteOutcome(const Pair& pair, bool used) {
 // The registration explains the fixes when the median squared residual, normalised by each fix's
 // sigma, stays within the gate (the median ignores the rare outlier). A chi-square(3) variable
 // has median 2.37; the gate (99.9 %) leaves room for the receiver's unmodelled bias.
-bool GnssFusion::Impl::residualsConsistent(const Eigen::Isometry3d& T) const {
+bool GnssFusion::Impl::residualsConsistent(const Eigen::Isometry3d& T,
+                                           const std::vector<bool>& use) const {
   std::vector<double> chi2;
-  for (const Pair& p : alignment_pairs) {
+  for (std::size_t i = 0; i < alignment_pairs.size(); ++i) {
+    if (!use[i]) continue;
+    const Pair& p = alignment_pairs[i];
     const Eigen::Vector3d r = p.p_enu - T * (p.T_w_b * config.lever_arm_b);
     const double var_h = p.fix.sigma_h_m * p.fix.sigma_h_m;
     chi2.push_back(r.head<2>().squaredNorm() / var_h +
                    r.z() * r.z() / (p.fix.sigma_v_m * p.fix.sigma_v_m));
   }
+  if (chi2.empty()) return false;
   const auto mid = chi2.begin() + static_cast<std::ptrdiff_t>(chi2.size() / 2);
   std::nth_element(chi2.begin(), mid, chi2.end());
   return *mid <= config.gate_chi2;
 }
 
+std::optional<Eigen::Isometry3d> GnssFusion::Impl::registration(
+    const std::vector<bool>& use) const {
+  std::vector<Eigen::Vector3d> p_w, p_enu;
+  for (std::size_t i = 0; i < alignment_pairs.size(); ++i) {
+    if (!use[i]) continue;
+    p_w.push_back(alignment_pairs[i].T_w_b * config.lever_arm_b);
+    p_enu.push_back(alignment_pairs[i].p_enu);
+  }
+  std::optional<Eigen::Isometry3d> T =
+      alignVioToEnu(p_w, p_enu, config.alignment, config.alignment_min_extent_m,
+                    config.alignment_min_cross_extent_m);
+  if (T && config.alignment == AlignmentDof::kRotationTranslation &&
+      !residualsConsistent(*T, use)) {
+    T.reset();  // e.g. a tilted start under the yaw-only stand-in: wait for more spread
+  }
+  return T;
+}
+
+// The pairs the registration rests on: all of them while the least-squares registration leaves
+// none outside the gate; else the largest consensus (fusion/alignment_consensus.hpp), and only
+// when it is a clear majority (two thirds) of at least alignment_min_fixes pairs, so that a
+// burst of outliers early in the drive cannot outvote the good fixes: then the registration
+// waits for more fixes.
+std::optional<std::vector<bool>> GnssFusion::Impl::registrationPairs(
+    const Eigen::Isometry3d& T_ls) const {
+  std::vector<AlignmentSample> samples;
+  bool all_within_gate = true;
+  for (const Pair& p : alignment_pairs) {
+    samples.push_back({p.T_w_b * config.lever_arm_b, p.p_enu, p.fix.sigma_h_m, p.fix.sigma_v_m});
+    all_within_gate = all_within_gate && registrationChi2(T_ls, samples.back(),
+                                                          config.gate_floor_m) <= config.gate_chi2;
+  }
+  if (all_within_gate) return std::vector<bool>(alignment_pairs.size(), true);
+  std::vector<bool> inliers = consensusInliers(samples, config.gate_chi2, config.gate_floor_m);
+  const auto count = static_cast<std::size_t>(std::count(inliers.begin(), inliers.end(), true));
+  if (count < static_cast<std::size_t>(config.alignment_min_fixes) ||
+      3 * count < 2 * alignment_pairs.size()) {
+    return std::nullopt;
+  }
+  return inliers;
+}
+
 void GnssFusion::Impl::align(const Pair& pair) {
   alignment_pairs.push_back(pair);
   if (static_cast<int>(alignment_pairs.size()) < config.alignment_min_fixes) return;
-  std::vector<Eigen::Vector3d> p_w, p_enu;
-  for (const Pair& p : alignment_pairs) {
-    p_w.push_back(p.T_w_b * config.lever_arm_b);
-    p_enu.push_back(p.p_enu);
-  }
-  T_enu_w = alignVioToEnu(p_w, p_enu, config.alignment, config.alignment_min_extent_m,
-                          config.alignment_min_cross_extent_m);
-  if (T_enu_w && config.alignment == AlignmentDof::kRotationTranslation &&
-      !residualsConsistent(*T_enu_w)) {
-    T_enu_w.reset();  // e.g. a tilted start under the yaw-only stand-in: wait for more spread
-  }
+  std::vector<bool> use(alignment_pairs.size(), true);
+  T_enu_w = registration(use);
   if (!T_enu_w) return;
-  // Back-fill the poses seen so far with the registration, then start the chosen filter.
+  const std::optional<std::vector<bool>> kept = registrationPairs(*T_enu_w);
+  if (!kept) {
+    T_enu_w.reset();
+    return;
+  }
+  if (*kept != use) {
+    use = *kept;
+    T_enu_w = registration(use);
+    if (!T_enu_w) return;
+  }
+  // Back-fill the poses seen so far with the registration, then start the chosen filter; the
+  // pairs outside the consensus are rejected.
   stats.poses_before_alignment = static_cast<int>(vio.size());
   fused.t_ns = vio.t_ns;
   fused.poses.clear();
   for (const auto& T : vio.poses) fused.poses.push_back(*T_enu_w * T);
-  for (const Pair& p : alignment_pairs) {
-    noteOutcome(p, config.mode == FusionMode::kGraph ? fuseGraph(p) : fuseKf(p));
+  for (std::size_t i = 0; i < alignment_pairs.size(); ++i) {
+    const Pair& p = alignment_pairs[i];
+    noteOutcome(p, use[i] && (config.mode == FusionMode::kGraph ? fuseGraph(p) : fuseKf(p)));
   }
   alignment_pairs.clear();
 }

@@ -7,9 +7,10 @@
 
 #include "render/render_error.hpp"
 
-// Under LeakSanitizer, what Mesa allocates while a display is set up and torn down is not
-// checked: its driver keeps that state in its own globals and is unloaded by eglTerminate, after
-// which LSan sees the memory as leaked (with a stack it cannot name, so no suppression can match).
+// Under LeakSanitizer, Mesa's driver must stay loaded: it keeps its per-process state (screens,
+// shader caches, LLVM's JIT) in its own globals, and when eglTerminate unloads it those globals are
+// unmapped, so LSan finds the memory they pointed to unreferenced and reports it as leaked (with
+// stacks in a module that no longer exists). Pinned, that memory is what it is: reachable.
 #if defined(__has_feature)
 #if __has_feature(address_sanitizer)
 #define GVIO_LSAN 1
@@ -18,27 +19,31 @@
 #define GVIO_LSAN 1
 #endif
 #ifdef GVIO_LSAN
-#include <sanitizer/lsan_interface.h>
+#include <dlfcn.h>
+#include <link.h>
 #endif
 
 namespace gvio::render {
 namespace {
 
-// Leak checking off for the calling thread while it lives (a no-op without sanitizers).
-struct DriverAllocations {
+// Keeps every loaded Mesa/LLVM driver module in memory for the rest of the process (RTLD_NOLOAD
+// finds the module already loaded, RTLD_NODELETE pins it); a no-op without sanitizers.
+void pinDriverModules() {
 #ifdef GVIO_LSAN
-  DriverAllocations() {
-    __lsan_disable();
-  }
-  ~DriverAllocations() {
-    __lsan_enable();
-  }
-#else
-  DriverAllocations() = default;
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, std::size_t, void*) {
+        const char* name = info->dlpi_name;
+        if (name != nullptr && (std::strstr(name, "_dri.so") != nullptr ||
+                                std::strstr(name, "libgallium") != nullptr ||
+                                std::strstr(name, "libLLVM") != nullptr ||
+                                std::strstr(name, "libEGL_mesa") != nullptr)) {
+          dlopen(name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+        }
+        return 0;
+      },
+      nullptr);
 #endif
-  DriverAllocations(const DriverAllocations&) = delete;
-  DriverAllocations& operator=(const DriverAllocations&) = delete;
-};
+}
 
 bool hasClientExtension(const char* name) {
   const char* ext = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
@@ -84,7 +89,6 @@ EglContext::EglContext() {
 }
 
 bool EglContext::tryDisplay(EGLDisplay display, const std::string& platform) {
-  [[maybe_unused]] const DriverAllocations mesa;
   auto fail = [&](const char* step) {
     info_.attempts.push_back(
         fmt::format("{}: {} (EGL error 0x{:x})", platform, step, eglGetError()));
@@ -93,7 +97,9 @@ bool EglContext::tryDisplay(EGLDisplay display, const std::string& platform) {
   };
   if (display == EGL_NO_DISPLAY) return fail("no display");
   EGLint major = 0, minor = 0;
-  if (!eglInitialize(display, &major, &minor)) return fail("eglInitialize failed");
+  const bool initialised = eglInitialize(display, &major, &minor) == EGL_TRUE;
+  pinDriverModules();  // loaded by eglInitialize, even when it fails
+  if (!initialised) return fail("eglInitialize failed");
   if (!eglBindAPI(EGL_OPENGL_API)) return fail("no desktop OpenGL API");
   // No surface at all: everything renders into framebuffer objects. A config is still chosen
   // when available because some drivers reject EGL_NO_CONFIG_KHR.
@@ -129,7 +135,6 @@ bool EglContext::tryDisplay(EGLDisplay display, const std::string& platform) {
 
 EglContext::~EglContext() {
   if (display_ == EGL_NO_DISPLAY) return;
-  [[maybe_unused]] const DriverAllocations mesa;
   eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   eglDestroyContext(display_, context_);
   eglTerminate(display_);

@@ -1,8 +1,10 @@
 #include "cli/app.hpp"
 
+#include <glog/logging.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "cli/interrupt.hpp"
 #include "odometry/error.hpp"
 
 namespace gvio::cli {
@@ -22,6 +24,12 @@ void setupLogging(const CommonOptions& common) {
     level = spdlog::level::warn;
   logger->set_level(level);
   spdlog::set_default_logger(logger);
+  // Ceres reports through glog, whose warnings (e.g. a rank-deficient covariance, which the
+  // smoother handles) would reach the terminal as multi-line noise before our one-line messages:
+  // errors only, unless -v.
+  FLAGS_logtostderr = true;
+  FLAGS_minloglevel = common.verbose >= 1 ? google::GLOG_INFO : google::GLOG_ERROR;
+  if (!google::IsGoogleLoggingInitialized()) google::InitGoogleLogging("gvio");
 }
 
 // Bad input is the user's to fix (exit 2, one line); anything else is our bug (exit 1).
@@ -89,7 +97,9 @@ int runMain(int argc, char** argv) {
   app.add_flag("--no-progress", common.no_progress, "No progress bar or progress lines on stderr");
   app.fallthrough();
   app.require_subcommand(1);
-  app.footer("Exit codes: 0 success, 2 bad usage or bad input, 1 internal error.");
+  app.footer(
+      "Exit codes: 0 success, 2 bad usage or bad input, 1 internal error, 130/143 interrupted "
+      "(SIGINT/SIGTERM).");
 
   // Each subcommand is registered here only once it really works.
   std::vector<Command> commands;
@@ -107,6 +117,7 @@ int runMain(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   setupLogging(common);
+  ignoreFileSizeSignal();
   for (const auto& command : commands) {
     if (command.app->parsed()) return runGuarded(command.run);
   }

@@ -154,7 +154,12 @@ void applyOverride(const std::string& assignment, std::map<std::string, ConfigKe
   const std::string key = assignment.substr(0, eq);
   const auto it = keys.find(key);
   if (it == keys.end()) throw InvalidInput("--set: unknown config key '" + key + "'");
-  it->second->set(std::string_view(assignment).substr(eq + 1));
+  try {
+    it->second->set(std::string_view(assignment).substr(eq + 1));
+  } catch (const InvalidInput& e) {
+    throw InvalidInput("--set " + key + ": " +
+                       e.what());  // where the value came from, as a file's line
+  }
   origins[key] = 0;
 }
 

@@ -60,6 +60,7 @@ int runConsistency(const ConsistencyOptions& o) {
   if (!(o.max_distance_m > 0.0)) throw InvalidInput("--max-distance must be > 0");
   const fs::path run(o.run);
   if (!fs::is_directory(run)) throw io::InputError(run, 0, "run folder not found");
+  if (const auto warning = io::incompleteRunWarning(run)) spdlog::warn("{}", *warning);
   const fs::path pcd = run / "map.pcd";
   if (!fs::exists(pcd)) {
     throw io::InputError(pcd, 0, "no map in the run folder (gvio run writes it with map.enabled)");

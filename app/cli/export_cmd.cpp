@@ -3,6 +3,7 @@
 
 #include "cli/app.hpp"
 #include "export/run_export.hpp"
+#include "io/run_dir.hpp"
 #include "odometry/error.hpp"
 
 namespace gvio::cli {
@@ -22,6 +23,7 @@ int runExport(const ExportCliOptions& o) {
   }
   const std::filesystem::path out =
       o.out ? std::filesystem::path(*o.out) : exporter::defaultExportPath(o.run, *format);
+  if (const auto warning = io::incompleteRunWarning(o.run)) spdlog::warn("{}", *warning);
   const exporter::ExportResult r = exporter::exportRun(o.run, *format, out);
   for (const auto& file : r.written) spdlog::info("wrote {}", file.string());
   spdlog::info("{} {} from {}", r.count, r.what, r.source.string());

@@ -9,6 +9,7 @@
 #include "cli/app.hpp"
 #include "io/image_loader.hpp"
 #include "io/input_error.hpp"
+#include "io/run_dir.hpp"
 #include "odometry/error.hpp"
 #include "render/framebuffer.hpp"
 #include "render/renderer.hpp"
@@ -76,6 +77,7 @@ int runRender(const RenderCliOptions& o) {
   if (!std::filesystem::is_directory(out_dir)) {
     throw io::InputError(o.out, 0, "output folder does not exist");  // before rendering for nothing
   }
+  if (const auto warning = io::incompleteRunWarning(o.run)) spdlog::warn("{}", *warning);
   Stopwatch clock;
   const io::RunFiles run = io::readRunDir(o.run, viz::readOptionsFor(view, reference));
   const double read_ms = clock.lapMs();

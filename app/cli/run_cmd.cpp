@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli/app.hpp"
+#include "cli/interrupt.hpp"
 #include "run/pipeline.hpp"
 
 namespace gvio::cli {
@@ -55,6 +56,8 @@ int runRun(const RunOptions& opt, const CommonOptions& common) {
   request.progress_done = [progress] {
     if (*progress) (*progress)->finish();
   };
+  const InterruptGuard interrupts;
+  request.pending_signal = &InterruptGuard::pending;
   return run::runPipeline(request, config);
 }
 

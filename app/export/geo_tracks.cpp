@@ -191,7 +191,10 @@ void writeTrack(const fs::path& file, std::span<const TrackPoint> track, TrackFo
   }
   registerGdal();
   const GdalErrorCapture errors;
-  const fs::path tmp = io::temporarySibling(file, extension(format));
+  // The name is reserved exclusively, then freed for GDAL, whose drivers refuse to create a
+  // dataset over an existing file (the name stays unique: PID and a random part).
+  const fs::path tmp = io::createTemporarySibling(file, extension(format));
+  fs::remove(tmp);
   try {
     {
       const bool libkml = GetGDALDriverManager()->GetDriverByName("LIBKML") != nullptr;

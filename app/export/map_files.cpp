@@ -20,44 +20,16 @@
 #include "io/input_error.hpp"
 #include "io/pcl_checks.hpp"
 #include "io/quiet_pcl.hpp"
+#include "io/quiet_stderr.hpp"
 #include "io/run_dir.hpp"
 
 namespace gvio::exporter {
 namespace {
 namespace fs = std::filesystem;
 
-// Debian's OctoMap is built with its debug messages on ("Reading binary octree type ...",
-// "Writing N nodes ... done.") and prints them with both fprintf(stderr) and std::cerr: stderr
-// (fd 2) points at /dev/null while OctoMap reads or writes, so the CLI's stderr stays its own.
-// (Files are checked by io::readOccupancy before OctoMap reads them.)
-class QuietStderr {
- public:
-  QuietStderr() {
-    std::fflush(stderr);
-    std::cerr.flush();
-    saved_ = ::dup(2);
-    const int null_fd = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
-    if (saved_ >= 0 && null_fd >= 0) ::dup2(null_fd, 2);
-    if (null_fd >= 0) ::close(null_fd);
-  }
-  ~QuietStderr() {
-    std::fflush(stderr);
-    std::cerr.flush();
-    if (saved_ >= 0) {
-      ::dup2(saved_, 2);
-      ::close(saved_);
-    }
-  }
-  QuietStderr(const QuietStderr&) = delete;
-  QuietStderr& operator=(const QuietStderr&) = delete;
-
- private:
-  int saved_ = -1;
-};
-
 template <typename F>
 auto quietly(F&& f) {
-  const QuietStderr quiet;
+  const io::QuietStderr quiet;
   return f();
 }
 
@@ -172,13 +144,34 @@ void writePcd(const fs::path& file, const pcl::PCLPointCloud2& cloud) {
   io::writeFileAtomic(file, [&](std::ostream& out) {
     pcl::PCDWriter writer;
     if (writer.writeBinaryCompressed(out, cloud) != 0) {
+      if (!out) return;  // the stream failed (disk full, size limit): writeFileAtomic reports it
       throw io::InputError(file, 0, "PCL could not encode the cloud as binary compressed PCD");
     }
   });
 }
 
+namespace {
+
+// What PCL's binary PLY writer (io/src/ply_io.cpp, writeBinary) puts after the header per point:
+// each field but padding ("_"), a uint count first when it has several elements, a float "rgb"
+// as three uchar (red, green, blue).
+std::uint64_t plyBodyBytes(const pcl::PCLPointCloud2& cloud) {
+  std::uint64_t point_bytes = 0;
+  for (const pcl::PCLPointField& f : cloud.fields) {
+    if (f.name == "_") continue;
+    const std::uint64_t count = std::max<std::uint32_t>(f.count, 1);
+    const bool rgb =
+        f.datatype == pcl::PCLPointField::FLOAT32 && f.name.find("rgb") != std::string::npos;
+    point_bytes += (count > 1 ? sizeof(std::uint32_t) : 0) +
+                   count * (rgb ? 3 : static_cast<std::uint64_t>(pcl::getFieldSize(f.datatype)));
+  }
+  return point_bytes * cloud.width * cloud.height;
+}
+
+}  // namespace
+
 void writePly(const fs::path& file, const pcl::PCLPointCloud2& cloud) {
-  const fs::path tmp = io::temporarySibling(file, ".ply");
+  const fs::path tmp = io::createTemporarySibling(file, ".ply");
   pcl::PLYWriter writer;
   int rc = -1;
   {
@@ -190,6 +183,13 @@ void writePly(const fs::path& file, const pcl::PCLPointCloud2& cloud) {
     std::error_code ignored;
     fs::remove(tmp, ignored);
     throw io::InputError(file, 0, "cannot write (missing directory or no permission)");
+  }
+  try {
+    io::checkWrittenPly(tmp, file, plyBodyBytes(cloud));
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw;
   }
   io::moveIntoPlace(tmp, file);
 }

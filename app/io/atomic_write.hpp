@@ -1,24 +1,36 @@
 #pragma once
 // Every output file is written to a temporary sibling and renamed into place, so a reader never
-// sees a half-written file and a failed run never leaves a truncated one behind.
+// sees a half-written file and a failed run never leaves a truncated one behind. Temporaries are
+// created exclusively (O_EXCL: never someone else's file or link) as hidden siblings named
+// `.NAME.gvio-tmp-PID-N[SUFFIX]`; one left behind by a process that was killed (SIGKILL, power
+// loss) is recognised by its dead PID and removed by removeStaleTemporaries.
 #include <filesystem>
 #include <functional>
 #include <ostream>
 #include <string_view>
+#include <vector>
 
 namespace gvio::io {
 
 // Calls `write` with a stream on a temporary file next to `path`, then renames it to `path`.
-// Throws InputError (naming `path`) when the directory is missing or unwritable.
+// Throws InputError (naming `path`) when the directory is missing or unwritable, or a write fails
+// (disk full, file size limit): the temporary is removed and `path` keeps its earlier content.
 void writeFileAtomic(const std::filesystem::path& path,
                      const std::function<void(std::ostream&)>& write);
 void writeTextAtomic(const std::filesystem::path& path, std::string_view text);
 
-// For writers that need a file path of their own (e.g. PCL's): the temporary sibling to write,
-// ending in `suffix` (some libraries choose the format by extension), and the rename into place
-// (the temporary is removed and InputError naming `path` thrown when that fails).
-std::filesystem::path temporarySibling(const std::filesystem::path& path,
-                                       std::string_view suffix = "");
+// For writers that need a file path of their own (e.g. PCL's): a new, empty temporary sibling of
+// `path`, created exclusively, ending in `suffix` (some libraries choose the format by
+// extension), and the rename into place (the temporary is removed and InputError naming `path`
+// thrown when that fails). Throws InputError naming `path` when the temporary cannot be created.
+std::filesystem::path createTemporarySibling(const std::filesystem::path& path,
+                                             std::string_view suffix = "");
 void moveIntoPlace(const std::filesystem::path& tmp, const std::filesystem::path& path);
+
+// Whether `file` is named like one of our temporaries (any process's).
+bool isTemporaryName(const std::filesystem::path& file);
+
+// Removes the temporaries in `dir` whose process is gone (left by a killed run); returns them.
+std::vector<std::filesystem::path> removeStaleTemporaries(const std::filesystem::path& dir);
 
 }  // namespace gvio::io

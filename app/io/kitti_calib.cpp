@@ -40,6 +40,22 @@ Eigen::Isometry3d readRt(const KittiCalibFile& file, const std::string& r_key,
   return T;
 }
 
+// A pinhole camera matrix [fx s cx; 0 fy cy; 0 0 1] (row-major, `stride` 3 for K, 4 for P): its
+// last row fixed, so the matrix is invertible and the projection homogeneous (a zeroed last row
+// would divide by zero in every projection).
+void requireCameraMatrix(const std::vector<double>& m, std::size_t stride,
+                         const KittiCalibFile& c2c, const std::string& key) {
+  const auto at = [&](std::size_t r, std::size_t c) { return m[r * stride + c]; };
+  const bool ok = at(0, 0) > 0.0 && at(1, 1) > 0.0 && at(1, 0) == 0.0 && at(2, 0) == 0.0 &&
+                  at(2, 1) == 0.0 && std::abs(at(2, 2) - 1.0) < 1e-9;
+  if (!ok) {
+    throw InputError(c2c.path(), c2c.lineOf(key),
+                     key +
+                         " is not a camera matrix (expected fx > 0, fy > 0 and rows 2-3 "
+                         "0 fy cy / 0 0 1)");
+  }
+}
+
 CameraModel rectifiedCamera(const KittiCalibFile& c2c, int id) {
   const auto S = c2c.numbers(fmt::format("S_rect_{:02d}", id), 2);
   const auto P = c2c.numbers(fmt::format("P_rect_{:02d}", id), 12);
@@ -52,6 +68,7 @@ CameraModel rectifiedCamera(const KittiCalibFile& c2c, int id) {
   cam.cx = P[2];
   cam.cy = P[6];
   // P_rect = K_rect [I | t]: the 4th column is K_rect t (devkit readme, "P_rect_xx").
+  requireCameraMatrix(P, 4, c2c, fmt::format("P_rect_{:02d}", id));
   Eigen::Matrix3d K;
   K << P[0], P[1], P[2], P[4], P[5], P[6], P[8], P[9], P[10];
   const Eigen::Vector3d t = K.inverse() * Eigen::Vector3d(P[3], P[7], P[11]);
@@ -79,9 +96,7 @@ CameraModel rawCamera(const KittiCalibFile& c2c, int id) {
   cam.cx = K[2];
   cam.cy = K[5];
   cam.distortion = c2c.numbers(fmt::format("D_{:02d}", id), 5);
-  if (!(cam.fx > 0.0 && cam.fy > 0.0)) {
-    throw InputError(c2c.path(), 0, fmt::format("K_{:02d} is not a camera matrix", id));
-  }
+  requireCameraMatrix(K, 3, c2c, fmt::format("K_{:02d}", id));
   requireImageSize(cam, c2c, fmt::format("S_{:02d}", id));
   cam.T_b_c = readRt(c2c, fmt::format("R_{:02d}", id), fmt::format("T_{:02d}", id));
   return cam;
@@ -95,6 +110,11 @@ std::filesystem::path findOne(const std::filesystem::path& drive_dir, const char
 }
 
 }  // namespace
+
+std::size_t KittiCalibFile::lineOf(const std::string& key) const {
+  const auto it = entries_.find(key);
+  return it == entries_.end() ? 0 : it->second.line;
+}
 
 KittiCalibFile::KittiCalibFile(const std::filesystem::path& file) : path_(file) {
   LineReader reader(file);

@@ -21,6 +21,8 @@ class KittiCalibFile {
   // a value is malformed or the count differs from `count`.
   [[nodiscard]] std::vector<double> numbers(const std::string& key, std::size_t count) const;
   [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+  // The line the key is on, 0 when it is missing.
+  [[nodiscard]] std::size_t lineOf(const std::string& key) const;
 
  private:
   struct Entry {

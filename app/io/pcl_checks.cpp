@@ -219,4 +219,24 @@ void checkPlyFile(const fs::path& file) {
   }
   throw InputError(file, 0, "PLY header without end_header");
 }
+
+void checkWrittenPly(const fs::path& written, const fs::path& file, std::uint64_t body_bytes) {
+  std::ifstream in(written, std::ios::binary);
+  std::string head(1 << 16, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  constexpr std::string_view kEnd = "end_header\n";
+  const std::size_t end = head.find(kEnd);
+  std::error_code ec;
+  const std::uint64_t bytes = fs::file_size(written, ec);
+  const std::uint64_t expected = end + kEnd.size() + body_bytes;
+  if (ec || end == std::string::npos || bytes != expected) {
+    throw InputError(file, 0,
+                     "write failed (disk full or file size limit?): " +
+                         std::to_string(ec ? 0 : bytes) + " bytes written, " +
+                         (end == std::string::npos ? std::string("no whole header")
+                                                   : std::to_string(expected) + " expected"));
+  }
+}
+
 }  // namespace gvio::io

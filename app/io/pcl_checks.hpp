@@ -5,6 +5,7 @@
 // the formats' specifications (PCD v0.7 at pointclouds.org; PLY as in Greg Turk's description)
 // and refuse such files with one line naming the file.
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 
 namespace gvio::io {
@@ -18,5 +19,12 @@ std::size_t checkPcdFile(const std::filesystem::path& file);
 // known types and counts the file can hold, up to end_header; no list property in the vertex
 // element. Throws InputError (file and header line).
 void checkPlyFile(const std::filesystem::path& file);
+
+// PCL's writers that take a file name do not check their stream: on a full disk or past the file
+// size limit they report success with a short file. `written` is what such a writer produced for
+// `file`; throws InputError naming `file` unless it holds a whole PLY header and exactly
+// `body_bytes` after it.
+void checkWrittenPly(const std::filesystem::path& written, const std::filesystem::path& file,
+                     std::uint64_t body_bytes);
 
 }  // namespace gvio::io

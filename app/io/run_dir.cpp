@@ -146,6 +146,28 @@ std::vector<TimeSpan> readOutages(const fs::path& file) {
   return spans;
 }
 
+std::optional<std::string> incompleteRunWarning(const fs::path& dir) {
+  const fs::path file = dir / "report.json";
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return std::nullopt;
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  if (!j.is_object() || !j.contains("status") || !j["status"].is_string()) return std::nullopt;
+  const std::string status = j["status"].get<std::string>();
+  if (status == "complete") return std::nullopt;
+  // Only words of gvio's own are echoed: the file may hold anything.
+  const auto word = [](const std::string& w) {
+    return !w.empty() && w.size() <= 32 && std::all_of(w.begin(), w.end(), [](char c) {
+      return (c >= 'a' && c <= 'z') || c == '_';
+    });
+  };
+  std::string how = word(status) ? "status \"" + status + "\"" : "an unknown status";
+  if (j.contains("stage") && j["stage"].is_string() && word(j["stage"].get<std::string>())) {
+    how += " in stage " + j["stage"].get<std::string>();
+  }
+  return file.string() + ": the run did not complete (" + how +
+         "): files it had not replaced yet are from an earlier run";
+}
+
 RunFiles readRunDir(const fs::path& dir, const RunReadOptions& options) {
   if (!fs::is_directory(dir)) throw InputError(dir, 0, "run folder not found");
   RunFiles run;

@@ -75,6 +75,12 @@ struct RunReadOptions {
   bool loops = true;       // read loops.csv when present
 };
 
+// A warning when `dir`/report.json says its run did not complete (status "running",
+// "interrupted" or "failed": gvio run's run/run_status.hpp), so files it had not replaced yet may
+// be an earlier run's; nullopt for a complete run, no report or an unreadable one (the readers
+// that need it report that).
+std::optional<std::string> incompleteRunWarning(const std::filesystem::path& dir);
+
 // Reads every file present (the map files as `options` asks). Throws InputError when the folder
 // is missing or holds neither trajectory.tum nor trajectory_vio.tum, or when a present file is
 // malformed (naming the file and, for text files, the line).

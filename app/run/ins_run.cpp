@@ -186,6 +186,7 @@ json gnssInsReport(const io::Dataset& ds, const InsRunResult& r, const InsReport
   const std::optional<Eigen::Vector2d> nhc = nhcMeanInnovation(s);
   json report;
   report["gvio_version"] = GVIO_VERSION;
+  report["status"] = "complete";  // a run in progress or cut short says so (run/run_status.hpp)
   report["command_line"] = ctx.command_line;
   report["dataset"] = datasetJson(ds);
   report["mode"] = "gnss-ins";

@@ -13,6 +13,7 @@
 #include "fusion/vio_enu_alignment.hpp"
 #include "io/atomic_write.hpp"
 #include "io/input_error.hpp"
+#include "io/quiet_stderr.hpp"
 #include "run/stats.hpp"
 
 namespace gvio::run {
@@ -23,17 +24,16 @@ nlohmann::json timingJson(const std::vector<double>& ms) {
   return {{"mean", t.mean}, {"p95", t.p95}, {"max", t.max}, {"n", ms.size()}};
 }
 
-// OctoMap writes by file name: a temporary sibling with the same extension, then the rename.
-// `binary`: the maximum-likelihood .bt of an OcTree; else the full .ot of any tree.
+// OctoMap's stream writers, through writeFileAtomic (which checks the stream): `binary`, the
+// maximum-likelihood .bt of an OcTree; else the full .ot of any tree.
 void writeTreeAtomic(const std::filesystem::path& file,
                      const octomap::AbstractOccupancyOcTree& tree, bool binary) {
-  const std::filesystem::path tmp = io::temporarySibling(file, file.extension().string());
-  const bool ok = binary ? tree.writeBinaryConst(tmp.string()) : tree.write(tmp.string());
-  if (!ok) {
-    std::filesystem::remove(tmp);
-    throw io::InputError(file, 0, "cannot write the OctoMap file");
-  }
-  io::moveIntoPlace(tmp, file);
+  io::writeFileAtomic(file, [&](std::ostream& out) {
+    const io::QuietStderr quiet;  // the map stage's threads are done by now
+    if (!(binary ? tree.writeBinaryConst(out) : tree.write(out))) {
+      throw io::InputError(file, 0, "OctoMap could not write the tree");
+    }
+  });
 }
 
 // The merged cloud (sparse landmarks first, then the dense points) as PCL's blob without a merged

@@ -37,14 +37,18 @@ struct RunRequest {
   std::string command_line;  // report.json
   std::string config_yaml;   // the effective configuration, written as config.yaml
   ProgressFn progress;       // VIO frames done / total; may be empty
+  // The signal (SIGINT, SIGTERM) that asks the run to stop, 0 while none; may be empty. Polled
+  // at every frame and stage boundary (run/run_status.hpp).
+  std::function<int()> pending_signal;
   std::function<void()> progress_done;
 };
 
 // "auto", "off", "kf" or "graph"; else InvalidInput naming --gnss.
 void checkGnssOption(const std::string& gnss);
 
-// Runs every stage and writes the run folder; returns the exit code. Throws InvalidInput (or
-// io::InputError) for bad input, naming the file and line.
+// Runs every stage and writes the run folder; returns the exit code (0, or 128 + the signal
+// when interrupted: 130 for SIGINT, 143 for SIGTERM). Throws InvalidInput (or io::InputError) for
+// bad input, naming the file and line; report.json then says the run failed.
 int runPipeline(const RunRequest& request, const RunConfig& config);
 
 }  // namespace gvio::run

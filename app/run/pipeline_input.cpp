@@ -74,7 +74,6 @@ bool runGnssInsInstead(RunState& s) {
   const fusion::InsConfig ins =
       s.config.fusion.insConfig(dataset_noise ? *ds.imu_noise : s.config.imu.noise);
   const fs::path& out = s.request.out;
-  makeOutputDir(out);
   spdlog::info("{} {} ({}): no camera frames, {} IMU samples, {} fixes: GNSS/INS",
                io::toString(ds.format), ds.root.string(), ds.variant, ds.imu.size(),
                ds.gnss.size());

@@ -6,8 +6,34 @@
 #include "io/atomic_write.hpp"
 #include "io/loops_csv.hpp"
 #include "io/trajectory_io.hpp"
+#include "run/run_status.hpp"
 
 namespace gvio::run {
+namespace {
+
+// The estimator bridges an IMU gap longer than max_imu_gap_s on vision alone (vio_prediction.cpp):
+// worth a warning, since a recording with such gaps is usually a dropped or mis-stamped log.
+void warnImuGaps(const io::Dataset& ds, const odometry::EstimatorConfig& estimator) {
+  if (!odometry::usesImu(estimator.mode) || ds.imu.size() < 2) return;
+  const auto max_gap_ns = static_cast<std::int64_t>(estimator.max_imu_gap_s * 1e9);
+  std::size_t gaps = 0, longest = 1;
+  for (std::size_t i = 1; i < ds.imu.size(); ++i) {
+    const std::int64_t dt = ds.imu[i].t_ns - ds.imu[i - 1].t_ns;
+    if (dt <= max_gap_ns) continue;
+    ++gaps;
+    if (dt > ds.imu[longest].t_ns - ds.imu[longest - 1].t_ns) longest = i;
+  }
+  if (gaps == 0) return;
+  const std::int64_t t0 = ds.frames.empty() ? ds.imu.front().t_ns : ds.frames.front().t_ns;
+  spdlog::warn(
+      "{}: {} gap(s) in the IMU longer than vio.max_imu_gap_s = {:.2f} s, the longest {:.2f} s "
+      "from t = {:.2f} s: the VIO bridges them on vision alone",
+      ds.root.string(), gaps, estimator.max_imu_gap_s,
+      static_cast<double>(ds.imu[longest].t_ns - ds.imu[longest - 1].t_ns) * 1e-9,
+      static_cast<double>(ds.imu[longest - 1].t_ns - t0) * 1e-9);
+}
+
+}  // namespace
 
 void runVioStage(RunState& s) {
   const io::Dataset& ds = s.dataset;
@@ -16,10 +42,10 @@ void runVioStage(RunState& s) {
   const bool dataset_noise = ds.imu_noise && s.config.imu.prefer_dataset_noise;
   s.estimator.imu_noise = dataset_noise ? *ds.imu_noise : s.config.imu.noise;
   s.estimator.validate();
+  warnImuGaps(ds, s.estimator);
   if (odometry::usesImu(s.estimator.mode))
     s.imu_noise_source = dataset_noise ? "dataset" : "config";
   const std::filesystem::path& out = s.request.out;
-  makeOutputDir(out);
   spdlog::info("{} {} ({}): {} frames, mode {}", io::toString(ds.format), ds.root.string(),
                ds.variant, ds.frames.size(), odometry::toString(s.estimator.mode));
   if (s.config.map.enabled) s.map_recorder.emplace(s.config.map.map);
@@ -29,6 +55,9 @@ void runVioStage(RunState& s) {
   VioRunOptions options;
   options.progress = s.request.progress;
   options.threads = s.request.threads;
+  if (s.request.pending_signal) {
+    options.stop = [&s] { return s.request.pending_signal() != 0; };
+  }
   if (s.map_recorder || s.loop_recorder) {
     // Only the keyframe thread touches the recorders until runVio returns.
     options.on_keyframe = [&s](const KeyframeInput& kf) {
@@ -38,6 +67,7 @@ void runVioStage(RunState& s) {
   }
   s.vio = runVio(ds, s.estimator, options);
   if (s.request.progress_done) s.request.progress_done();
+  if (s.vio.stopped) stopIfInterrupted(s);  // nothing of a cut-short VIO is written
   if (s.vio.trajectory.empty()) {
     spdlog::warn("the estimator never initialised: trajectory_vio.tum is empty");
     io::writeTextAtomic(out / "trajectory_vio.tum", "");

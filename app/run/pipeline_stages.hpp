@@ -23,6 +23,7 @@ struct RunState {
   RunState(const RunRequest& r, const RunConfig& c) : request(r), config(c) {}
   const RunRequest& request;
   const RunConfig& config;
+  std::string stage;  // the stage running, for report.json when the run does not complete
   io::Dataset dataset;
   nlohmann::json gnss_noise;  // report.json's record of the degradation, null for none
   odometry::EstimatorConfig estimator;

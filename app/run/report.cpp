@@ -63,6 +63,7 @@ json datasetJson(const io::Dataset& ds) {
 json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportContext& ctx) {
   json report;
   report["gvio_version"] = GVIO_VERSION;
+  report["status"] = "complete";  // a run in progress or cut short says so (run/run_status.hpp)
   report["command_line"] = ctx.command_line;
   report["dataset"] = datasetJson(ds);
   report["mode"] = odometry::toString(run.mode);

@@ -195,6 +195,10 @@ VioRunResult runVio(const io::Dataset& ds, odometry::EstimatorConfig config,
       continue;
     }
     const io::FrameRecord& frame = *std::get<const io::FrameRecord*>(*m);
+    if (options.stop && options.stop()) {
+      r.stopped = true;
+      break;
+    }
     if (progress) progress(frames_done, ds.frames.size());
     ++frames_done;
     std::optional<LoadedFrame> loaded =

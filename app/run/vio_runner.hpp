@@ -48,6 +48,7 @@ struct VioRunResult {
   std::vector<std::pair<std::int64_t, double>> time_offset_history;
   FrameTimings timings;
   double wall_s = 0.0;
+  bool stopped = false;  // VioRunOptions::stop ended the run before the last frame
 };
 
 using ProgressFn = std::function<void(std::size_t frames_done, std::size_t frames_total)>;
@@ -76,6 +77,8 @@ struct VioRunOptions {
   // the calling thread tracks and estimates. The outputs are the same bit for bit: no decision
   // depends on which thread finishes first.
   int threads = 1;
+  // Polled before each frame; true stops the run there (VioRunResult::stopped). May be empty.
+  std::function<bool()> stop;
 };
 
 // `config.mode` and `config.imu_noise` are the run's (chooseVioMode, dataset or imu.* noise); the

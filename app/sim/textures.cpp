@@ -22,8 +22,13 @@ void scatter(Canvas& c, Rng& rng, int count_per_512, double r_lo, double r_hi, d
   const double k = c.width() / 512.0;
   const int count = static_cast<int>(count_per_512 * k * k);
   for (int i = 0; i < count; ++i) {
-    c.blendDisc(rng.uniform(0, c.width()), rng.uniform(0, c.height()), k * rng.uniform(r_lo, r_hi),
-                rng.uniform(v_lo, v_hi), alpha);
+    // Drawn one by one in the order GCC evaluated the arguments before (right to left), so the
+    // textures stay the same and any compiler draws them in this order.
+    const double value = rng.uniform(v_lo, v_hi);
+    const double radius = k * rng.uniform(r_lo, r_hi);
+    const double y = rng.uniform(0, c.height());
+    const double x = rng.uniform(0, c.width());
+    c.blendDisc(x, y, radius, value, alpha);
   }
 }
 
@@ -64,8 +69,10 @@ ProceduralTexture asphaltTexture(int size_px, std::uint64_t seed) {
   patches(c, rng, 4, 22.0);
   for (int i = 0; i < 7; ++i) {  // fine cracks, and wide ones sealed with tar (seen from afar)
     const bool sealed = i < 3;
-    crack(c, rng, rng.uniform(0, size_px), rng.uniform(0, size_px), rng.integer(15, 50),
-          (sealed ? 4.0 : 1.4) * size_px / 512.0, sealed ? 28.0 : 35.0);
+    const int steps = rng.integer(15, 50);  // drawn in GCC's former order, as in scatter()
+    const double y = rng.uniform(0, size_px);
+    const double x = rng.uniform(0, size_px);
+    crack(c, rng, x, y, steps, (sealed ? 4.0 : 1.4) * size_px / 512.0, sealed ? 28.0 : 35.0);
   }
   scatter(c, rng, 6, 15.0, 45.0, 55.0, 55.0, 0.3);  // oil stains
   return finish(c, 6.0, 6.0);
@@ -91,9 +98,10 @@ ProceduralTexture pavingTexture(int size_px, std::uint64_t seed) {
       const double x = col * slab + shift, y = row * slab;
       const double tone = 150.0 + 14.0 * rng.normal();
       c.blendRect(x + joint / 2, y + joint / 2, x + slab - joint / 2, y + slab - joint / 2, tone);
-      if (rng.chance(0.1)) {  // broken slab
-        c.blendLine(x + rng.uniform(0, slab), y, x + rng.uniform(0, slab), y + slab, joint, 80.0,
-                    0.8);
+      if (rng.chance(0.1)) {                         // broken slab
+        const double x1 = x + rng.uniform(0, slab);  // GCC's former order, as in scatter()
+        const double x0 = x + rng.uniform(0, slab);
+        c.blendLine(x0, y, x1, y + slab, joint, 80.0, 0.8);
       }
     }
   }
@@ -157,7 +165,9 @@ ProceduralTexture barkTexture(int size_px, std::uint64_t seed) {
   c.addValueNoise(rng, 64, 8, 12.0);
   for (int i = 0; i < 40; ++i) {
     const double x = rng.uniform(0, size_px), y = rng.uniform(0, size_px);
-    c.blendLine(x, y, x + rng.uniform(-4, 4), y + rng.uniform(30, 120), 2.0, 30.0, 0.7);
+    const double y1 = y + rng.uniform(30, 120);  // GCC's former order, as in scatter()
+    const double x1 = x + rng.uniform(-4, 4);
+    c.blendLine(x, y, x1, y1, 2.0, 30.0, 0.7);
   }
   c.addWhiteNoise(rng, 9.0);
   return finish(c, 1.0, 2.0);

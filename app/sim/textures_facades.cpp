@@ -93,7 +93,11 @@ void paintWallDetails(Canvas& c, Rng& rng, double width_m, double height_m, doub
   MetricCanvas m(c, width_m, height_m);
   for (int i = 0; i < 5; ++i) {  // repairs and stains
     const double x = rng.uniform(0.0, width_m), z = rng.uniform(0.0, height_m);
-    m.addRect(x, z, x + rng.uniform(0.5, 3.0), z + rng.uniform(0.5, 2.5), rng.uniform(-25.0, 20.0));
+    // Drawn in the order GCC evaluated the arguments before (right to left): the same facades.
+    const double delta = rng.uniform(-25.0, 20.0);
+    const double z1 = z + rng.uniform(0.5, 2.5);
+    const double x1 = x + rng.uniform(0.5, 3.0);
+    m.addRect(x, z, x1, z1, delta);
   }
   const double pipe = rng.uniform(0.0, width_m);
   m.rect(pipe, 0.0, pipe + 0.1, height_m, std::clamp(tone + rng.uniform(-60.0, 60.0), 30.0, 230.0));
@@ -127,7 +131,8 @@ void paintWindow(MetricCanvas& m, Rng& rng, const FacadeStyle& s, double x, doub
   m.rect(x - 0.12, z - 0.1, x + w + 0.12, z + h + 0.12, s.wall - 25.0, 0.6);  // reveal shadow
   const double glass = rng.uniform(20.0, 75.0);
   m.rect(x, z, x + w, z + h, glass);
-  m.rect(x, z + h * rng.uniform(0.3, 0.7), x + w, z + h, glass + rng.uniform(15.0, 45.0), 0.5);
+  const double reflection = glass + rng.uniform(15.0, 45.0);  // GCC's former order (right to left)
+  m.rect(x, z + h * rng.uniform(0.3, 0.7), x + w, z + h, reflection, 0.5);
   if (rng.chance(0.35)) {  // blinds down to some height, with slats
     const double bottom = z + h * rng.uniform(0.0, 0.8), tone = rng.uniform(135.0, 205.0);
     m.rect(x, bottom, x + w, z + h, tone);
