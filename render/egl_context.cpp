@@ -7,18 +7,20 @@
 
 #include "render/render_error.hpp"
 
-// Under LeakSanitizer, Mesa's driver must stay loaded: it keeps its per-process state (screens,
-// shader caches, LLVM's JIT) in its own globals, and when eglTerminate unloads it those globals are
-// unmapped, so LSan finds the memory they pointed to unreferenced and reports it as leaked (with
-// stacks in a module that no longer exists). Pinned, that memory is what it is: reachable.
+// Under the sanitizers Mesa's driver must stay loaded. LeakSanitizer: the driver keeps its
+// per-process state (screens, shader caches, LLVM's JIT) in its own globals, and when eglTerminate
+// unloads it those globals are unmapped, so LSan finds the memory they pointed to unreferenced and
+// reports it as leaked (with stacks in a module that no longer exists); pinned, that memory is
+// what it is: reachable. ThreadSanitizer: its suppressions name the driver
+// (tests/sanitizers/tsan.supp), and it aborts when a library so named is unloaded.
 #if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define GVIO_LSAN 1
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define GVIO_PIN_DRIVER 1
 #endif
-#elif defined(__SANITIZE_ADDRESS__)
-#define GVIO_LSAN 1
+#elif defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define GVIO_PIN_DRIVER 1
 #endif
-#ifdef GVIO_LSAN
+#ifdef GVIO_PIN_DRIVER
 #include <dlfcn.h>
 #include <link.h>
 #endif
@@ -29,7 +31,7 @@ namespace {
 // Keeps every loaded Mesa/LLVM driver module in memory for the rest of the process (RTLD_NOLOAD
 // finds the module already loaded, RTLD_NODELETE pins it); a no-op without sanitizers.
 void pinDriverModules() {
-#ifdef GVIO_LSAN
+#ifdef GVIO_PIN_DRIVER
   dl_iterate_phdr(
       [](dl_phdr_info* info, std::size_t, void*) {
         const char* name = info->dlpi_name;

@@ -2,12 +2,17 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <csignal>
 
 namespace gvio::cli {
 namespace {
 
-volatile std::sig_atomic_t g_signal = 0;  // NOLINT: written by the handler, see the header
+// Written by the handler on whichever thread takes the signal, read by the run's thread: a
+// lock-free atomic is both async-signal-safe and free of data races (a volatile sig_atomic_t is
+// only the former).
+std::atomic<int> g_signal{0};  // NOLINT: see the header
+static_assert(std::atomic<int>::is_always_lock_free);
 
 extern "C" void onInterrupt(int signal) {
   g_signal = signal;
@@ -36,7 +41,7 @@ InterruptGuard::~InterruptGuard() {
 }
 
 int InterruptGuard::pending() {
-  return static_cast<int>(g_signal);
+  return g_signal.load();
 }
 
 void ignoreFileSizeSignal() {

@@ -168,7 +168,7 @@ void expectInterrupted(int sig, const std::string& name) {
   const Snapshot before = earlierRun(c);
   const fs::path err = c.dataset().parent_path() / "stderr.txt";
   Background run(runArgs(c.dataset(), c.out()), err);
-  waitUntilRunning(run, c.out(), std::chrono::milliseconds(1500));
+  waitUntilRunning(run, c.out(), std::chrono::milliseconds(500));  // well inside the VIO
   run.signal(sig);
   EXPECT_EQ(run.wait(), 128 + sig) << readText(err);
   const std::string text = readText(err);

@@ -1,5 +1,6 @@
-// gvio run --threads: the threaded pipeline (decoding ahead, keyframe work and the occupancy
-// beside the estimator) writes the same run folder, bit for bit, as --threads 1.
+// Determinism of gvio run: the same command twice writes the same run folder bit for bit, and the
+// threaded pipeline (decoding ahead, keyframe work and the occupancy beside the estimator) writes
+// the same folder as --threads 1.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -68,6 +69,32 @@ TEST(CliRunThreads, ThreadedRunWritesTheSameFilesAsOneThread) {
   EXPECT_GT(map["dense_points"].get<double>(), 0.0);
   // --threads is a run option, not configuration: config.yaml is the same.
   EXPECT_EQ(readText(one / "config.yaml"), readText(three / "config.yaml"));
+}
+
+// The determinism check: one command run twice (degraded GNSS with a seed, loops, the map),
+// every file the same byte for byte, report.json the same but for what measures time.
+TEST(CliRunDeterminism, TheSameCommandTwiceWritesTheSameBytes) {
+  const fs::path drive = cachedSimulation(
+      fmt::format("--trajectory {}/assets/demo/drive.tum --seconds 8 --seed 7", GVIO_SOURCE_DIR));
+  TempDir tmp("cli_run_twice");
+  for (const char* name : {"a", "b"}) {
+    const CommandResult r =
+        runGvio(fmt::format("run --dataset {} --out {} --no-progress --gnss-noise spp --seed 11 {}",
+                            quoted(drive), quoted(tmp.path() / name), kSimGeo));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  const fs::path a = tmp.path() / "a", b = tmp.path() / "b";
+  const std::set<std::string> files = filesIn(a);
+  EXPECT_EQ(files, filesIn(b));
+  EXPECT_TRUE(files.count("map.pcd") && files.count("trajectory.tum"));
+  for (const std::string& name : files) {
+    if (name == "report.json") continue;
+    EXPECT_TRUE(readText(a / name) == readText(b / name)) << name << " differs";
+  }
+  const auto report = [](const fs::path& dir) {
+    return withoutTimings(nlohmann::json::parse(readText(dir / "report.json")));
+  };
+  EXPECT_EQ(report(a), report(b));
 }
 
 TEST(CliRunThreads, RejectsZeroThreads) {
