@@ -26,11 +26,15 @@ struct PcdHeader {
   std::optional<std::size_t> points;
 };
 
+// Every value to the end of the line; nullopt when one does not parse (a COUNT of 10^82 overflows
+// size_t: stopping there left COUNT empty, read as all 1, while PCL allocated 6 GB for it; found
+// by fuzzing).
 template <typename T>
-std::vector<T> readAll(std::istringstream& in) {
+std::optional<std::vector<T>> readAll(std::istringstream& in) {
   std::vector<T> v;
   T x;
   while (in >> x) v.push_back(x);
+  if (!in.eof()) return std::nullopt;
   return v;
 }
 
@@ -78,14 +82,19 @@ std::size_t checkPcdFile(const fs::path& file) {
     if (!seen.insert(key).second) throw InputError(file, n, "PCD header repeats " + key);
     if (key == "VERSION" || key == "VIEWPOINT") continue;
     bool ok = true;
+    const auto all = [&ok, &ss]<typename T>(std::vector<T>& out) {
+      auto values = readAll<T>(ss);
+      ok = values.has_value();
+      if (ok) out = std::move(*values);
+    };
     if (key == "FIELDS") {
-      h.fields = readAll<std::string>(ss);
+      all(h.fields);
     } else if (key == "SIZE") {
-      h.size = readAll<std::size_t>(ss);
+      all(h.size);
     } else if (key == "COUNT") {
-      h.count = readAll<std::size_t>(ss);
+      all(h.count);
     } else if (key == "TYPE") {
-      h.type = readAll<char>(ss);
+      all(h.type);
     } else if (key == "WIDTH") {
       ok = static_cast<bool>(ss >> h.width);
     } else if (key == "HEIGHT") {
@@ -107,7 +116,7 @@ std::size_t checkPcdFile(const fs::path& file) {
     std::size_t step = 0;
     for (std::size_t i = 0; valid && i < k; ++i) {
       const std::size_t s = h.size[i];
-      valid = (s == 1 || s == 2 || s == 4 || s == 8) && h.count[i] >= 1 &&
+      valid = (s == 1 || s == 2 || s == 4 || s == 8) && h.count[i] >= 1 && h.count[i] <= 1024 &&
               (h.type[i] == 'I' || h.type[i] == 'U' || (h.type[i] == 'F' && s >= 4));
       step += s * h.count[i];
     }

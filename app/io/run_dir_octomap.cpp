@@ -25,6 +25,8 @@ struct OctreeHeader {
   std::size_t data_offset = 0;  // first byte of the node data
 };
 
+constexpr double kMaxResolutionM = 1000.0;
+
 // The text header OctoMap writes ("# Octomap OcTree [binary ]file", then id / size / res lines,
 // then "data"), parsed as AbstractOcTree::readHeader does.
 OctreeHeader parseHeader(const std::string& bytes, bool binary, const fs::path& file) {
@@ -58,6 +60,11 @@ OctreeHeader parseHeader(const std::string& bytes, bool binary, const fs::path& 
     if (key == "size") ok = static_cast<bool>(fields >> h.size);
     if (key == "res") ok = static_cast<bool>(fields >> h.res);
     if (!ok) throw InputError(file, line, "bad header line '" + text + "'");
+    // OctoMap keeps voxel centres in float: a resolution of 1e150 (found by fuzzing) makes them
+    // infinite. No map has voxels of a kilometre.
+    if (key == "res" && !(h.res > 0.0 && h.res <= kMaxResolutionM)) {
+      throw InputError(file, line, "resolution must be in (0, 1000] m");
+    }
   }
   throw InputError(file, 0, "header has no 'data' line");
 }

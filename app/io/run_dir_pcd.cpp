@@ -6,6 +6,7 @@
 #include <pcl/io/pcd_io.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <optional>
@@ -121,8 +122,15 @@ MapCloud readMapCloud(const fs::path& file) {
     const std::uint8_t* p = cloud.data.data() + i * cloud.point_step;
     const Eigen::Vector3d q((*x)(p), (*y)(p), (*z)(p));
     if (!q.allFinite()) continue;  // unorganised NaN padding
-    map.p_enu.push_back(q.cast<float>());
-    if (intensity) map.intensity.push_back(static_cast<float>((*intensity)(p)));
+    // Double fields beyond float's range would become infinite here (found by fuzzing).
+    const Eigen::Vector3f q_f = q.cast<float>();
+    const float value = intensity ? static_cast<float>((*intensity)(p)) : 0.0F;
+    if (!q_f.allFinite() || !std::isfinite(value)) {
+      throw InputError(file, 0,
+                       "point " + std::to_string(i) + ": a value that is not finite as a float");
+    }
+    map.p_enu.push_back(q_f);
+    if (intensity) map.intensity.push_back(value);
     if (source) {
       map.source.push_back(static_cast<std::uint8_t>(std::clamp((*source)(p), 0.0, 255.0)));
     }
