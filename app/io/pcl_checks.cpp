@@ -78,9 +78,10 @@ std::size_t checkPcdFile(const fs::path& file) {
     std::istringstream ss(line);
     std::string key;
     ss >> key;
-    // PCL skips an empty line but crashes reading a file with a line of blanks in its header (a
-    // null dereference in PCDReader::read, found by fuzzing).
-    if (key.empty() && line.find_first_not_of("\r") != std::string::npos) {
+    // PCL skips an empty line but crashes reading a file with a line of blanks (spaces, tabs or
+    // CRs: a CRLF empty line too) in its header: a null dereference in PCDReader::read, found by
+    // fuzzing.
+    if (key.empty() && !line.empty()) {
       throw InputError(file, n, "PCD header line of blanks only");
     }
     if (key.empty() || key[0] == '#') continue;
