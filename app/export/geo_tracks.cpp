@@ -191,11 +191,11 @@ void writeTrack(const fs::path& file, std::span<const TrackPoint> track, TrackFo
   }
   registerGdal();
   const GdalErrorCapture errors;
-  // The name is reserved exclusively, then freed for GDAL, whose drivers refuse to create a
-  // dataset over an existing file (the name stays unique: PID and a random part).
-  const fs::path tmp = io::createTemporarySibling(file, extension(format));
-  fs::remove(tmp);
-  try {
+  io::writeViaPathAtomic(file, extension(format), [&](const fs::path& tmp) {
+    // The name was reserved exclusively; it is freed for GDAL, whose drivers refuse to create a
+    // dataset over an existing file (the name stays unique: PID and a random part). LIBKML may
+    // leave a folder under it on failure, which writeViaPathAtomic removes too.
+    fs::remove(tmp);
     {
       const bool libkml = GetGDALDriverManager()->GetDriverByName("LIBKML") != nullptr;
       const char* driver = format == TrackFormat::kGeoJson ? "GeoJSON"
@@ -222,12 +222,7 @@ void writeTrack(const fs::path& file, std::span<const TrackPoint> track, TrackFo
     if (CPLGetLastErrorType() >= CE_Failure || !fs::exists(tmp)) {
       throw io::InputError(file, 0, "write failed: " + errors.lastMessage());
     }
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove_all(tmp, ignored);  // LIBKML may leave a folder for .kmz-less output
-    throw;
-  }
-  io::moveIntoPlace(tmp, file);
+  });
 }
 
 }  // namespace gvio::exporter

@@ -171,27 +171,16 @@ std::uint64_t plyBodyBytes(const pcl::PCLPointCloud2& cloud) {
 }  // namespace
 
 void writePly(const fs::path& file, const pcl::PCLPointCloud2& cloud) {
-  const fs::path tmp = io::createTemporarySibling(file, ".ply");
-  pcl::PLYWriter writer;
-  int rc = -1;
-  {
-    const io::QuietPcl quiet;
-    rc = writer.writeBinary(tmp.string(), cloud, Eigen::Vector4f::Zero(),
-                            Eigen::Quaternionf::Identity(), false);  // no camera element
-  }
-  if (rc != 0) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw io::InputError(file, 0, "cannot write (missing directory or no permission)");
-  }
-  try {
+  io::writeViaPathAtomic(file, ".ply", [&](const fs::path& tmp) {
+    int rc = -1;
+    {
+      const io::QuietPcl quiet;
+      rc = pcl::PLYWriter().writeBinary(tmp.string(), cloud, Eigen::Vector4f::Zero(),
+                                        Eigen::Quaternionf::Identity(), false);  // no camera
+    }
+    if (rc != 0) throw io::InputError(file, 0, "cannot write (missing directory or no permission)");
     io::checkWrittenPly(tmp, file, plyBodyBytes(cloud));
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw;
-  }
-  io::moveIntoPlace(tmp, file);
+  });
 }
 
 LasPointAt lasPointSource(const pcl::PCLPointCloud2& cloud) {

@@ -72,6 +72,19 @@ void moveIntoPlace(const fs::path& tmp, const fs::path& path) {
   }
 }
 
+void writeViaPathAtomic(const fs::path& path, std::string_view suffix,
+                        const std::function<void(const fs::path& tmp)>& write) {
+  const fs::path tmp = createTemporarySibling(path, suffix);
+  try {
+    write(tmp);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(tmp, ignored);
+    throw;
+  }
+  moveIntoPlace(tmp, path);
+}
+
 void writeFileAtomic(const fs::path& path, const std::function<void(std::ostream&)>& write) {
   const fs::path tmp = createTemporarySibling(path);
   auto discard = [&tmp] {

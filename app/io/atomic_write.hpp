@@ -27,6 +27,12 @@ std::filesystem::path createTemporarySibling(const std::filesystem::path& path,
                                              std::string_view suffix = "");
 void moveIntoPlace(const std::filesystem::path& tmp, const std::filesystem::path& path);
 
+// Both of the above around a writer that takes a file name (PCL's PLY, GDAL): `write` gets the
+// temporary and throws when it fails; then the temporary (or a folder a library left under its
+// name) is removed and `path` keeps its earlier content; else it is renamed into place.
+void writeViaPathAtomic(const std::filesystem::path& path, std::string_view suffix,
+                        const std::function<void(const std::filesystem::path& tmp)>& write);
+
 // Whether `file` is named like one of our temporaries (any process's).
 bool isTemporaryName(const std::filesystem::path& file);
 

@@ -31,24 +31,16 @@ void writeMeshPly(const std::filesystem::path& file, const TriangleMesh& mesh) {
     for (const std::uint32_t idx : t) face.vertices.push_back(static_cast<pcl::index_t>(idx));
     pm.polygons.push_back(face);
   }
-  // PCL writes to a path (and picks the format by extension): a temporary sibling, then rename.
-  const std::filesystem::path tmp = createTemporarySibling(file, ".ply");
-  if (pcl::io::savePLYFileBinary(tmp.string(), pm) != 0) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw InputError(file, 0, "cannot write (missing directory or no permission)");
-  }
   // x, y, z as float per vertex; per face a uchar count and its int indices.
   const std::uint64_t body = mesh.vertices.size() * 3 * sizeof(float) +
                              mesh.triangles.size() * (1 + 3 * sizeof(std::int32_t));
-  try {
+  // PCL writes to a path (and picks the format by extension).
+  writeViaPathAtomic(file, ".ply", [&](const std::filesystem::path& tmp) {
+    if (pcl::io::savePLYFileBinary(tmp.string(), pm) != 0) {
+      throw InputError(file, 0, "cannot write (missing directory or no permission)");
+    }
     checkWrittenPly(tmp, file, body);
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw;
-  }
-  moveIntoPlace(tmp, file);
+  });
 }
 
 namespace {
