@@ -69,12 +69,12 @@ void LandmarkMap::create(std::uint64_t id, const Observation& obs, const StereoG
 }
 
 Eigen::Vector3d LandmarkMap::worldPoint(const Landmark& lm, const double* anchor_pose,
-                                        const StereoGeometry& geometry) {
-  const Eigen::Vector3d p_c = geometry.bearing(lm.anchor().px_left) / lm.inv_depth;
+                                        const StereoGeometry& geometry, double t_d_s) {
+  const Eigen::Vector3d p_c = geometry.bearing(lm.anchor().leftAt(t_d_s)) / lm.inv_depth;
   return cameraInWorld(anchor_pose, geometry.left) * p_c;
 }
 
-void LandmarkMap::triangulate(const PoseLookup& poses, const StereoGeometry& geometry,
+void LandmarkMap::triangulate(const PoseLookup& poses, const StereoGeometry& geometry, double t_d_s,
                               double min_depth_m, double max_depth_m) {
   for (auto& [id, lm] : landmarks_) {
     if (lm.has_depth || lm.observations.size() < 2) continue;
@@ -83,8 +83,8 @@ void LandmarkMap::triangulate(const PoseLookup& poses, const StereoGeometry& geo
     if (pose_a == nullptr || pose_b == nullptr) continue;
     const Eigen::Isometry3d T_w_a = cameraInWorld(pose_a, geometry.left);
     const Eigen::Isometry3d T_w_b = cameraInWorld(pose_b, geometry.left);
-    const Eigen::Vector3d u_a = geometry.bearing(lm.anchor().px_left);
-    const Eigen::Vector3d u_b = geometry.bearing(lm.observations.back().px_left);
+    const Eigen::Vector3d u_a = geometry.bearing(lm.anchor().leftAt(t_d_s));
+    const Eigen::Vector3d u_b = geometry.bearing(lm.observations.back().leftAt(t_d_s));
     const Eigen::Vector3d ray_a = T_w_a.rotation() * u_a.normalized();
     const Eigen::Vector3d ray_b = T_w_b.rotation() * u_b.normalized();
     if (std::acos(std::clamp(ray_a.dot(ray_b), -1.0, 1.0)) < kMinTriangulationAngleRad) continue;
@@ -109,14 +109,14 @@ void LandmarkMap::triangulate(const PoseLookup& poses, const StereoGeometry& geo
 }
 
 void LandmarkMap::removeFrame(std::uint64_t frame_uid, const PoseLookup& poses,
-                              const StereoGeometry& geometry) {
+                              const StereoGeometry& geometry, double t_d_s) {
   for (auto it = landmarks_.begin(); it != landmarks_.end();) {
     Landmark& lm = it->second;
     const bool anchored_here = lm.anchor().frame_uid == frame_uid;
     Eigen::Vector3d p_w = Eigen::Vector3d::Zero();
     const double* old_anchor = anchored_here ? poses(frame_uid) : nullptr;
     const bool carry_depth = anchored_here && lm.has_depth && old_anchor != nullptr;
-    if (carry_depth) p_w = worldPoint(lm, old_anchor, geometry);
+    if (carry_depth) p_w = worldPoint(lm, old_anchor, geometry, t_d_s);
     std::erase_if(lm.observations,
                   [frame_uid](const Observation& o) { return o.frame_uid == frame_uid; });
     if (lm.observations.empty()) {
@@ -127,6 +127,7 @@ void LandmarkMap::removeFrame(std::uint64_t frame_uid, const PoseLookup& poses,
       lm.has_depth = false;
       const double* new_anchor = poses(lm.anchor().frame_uid);
       if (carry_depth && new_anchor != nullptr) {
+        // The depth along the new anchor's (time-shifted) bearing that reproduces the point.
         const Eigen::Vector3d p_c = cameraInWorld(new_anchor, geometry.left).inverse() * p_w;
         if (p_c.z() > 1e-3) {
           lm.inv_depth = 1.0 / p_c.z();
@@ -139,20 +140,21 @@ void LandmarkMap::removeFrame(std::uint64_t frame_uid, const PoseLookup& poses,
 }
 
 double LandmarkMap::meanReprojectionPx(const Landmark& lm, const PoseLookup& poses,
-                                       const StereoGeometry& geometry) {
+                                       const StereoGeometry& geometry, double t_d_s) {
   const double* anchor_pose = lm.has_depth ? poses(lm.anchor().frame_uid) : nullptr;
   if (anchor_pose == nullptr) return INFINITY;
-  const Eigen::Vector3d p_w = worldPoint(lm, anchor_pose, geometry);
+  const Eigen::Vector3d p_w = worldPoint(lm, anchor_pose, geometry, t_d_s);
   double sum = 0.0;
   int n = 0;
   for (const Observation& o : lm.observations) {
     const double* pose = poses(o.frame_uid);
     if (pose == nullptr) continue;
-    sum += reprojectionErrorPx(geometry.left, cameraInWorld(pose, geometry.left), p_w, o.px_left);
+    sum += reprojectionErrorPx(geometry.left, cameraInWorld(pose, geometry.left), p_w,
+                               o.leftAt(t_d_s));
     ++n;
     if (o.has_right && geometry.stereo) {
-      sum +=
-          reprojectionErrorPx(geometry.right, cameraInWorld(pose, geometry.right), p_w, o.px_right);
+      sum += reprojectionErrorPx(geometry.right, cameraInWorld(pose, geometry.right), p_w,
+                                 o.rightAt(t_d_s));
       ++n;
     }
   }
@@ -160,7 +162,8 @@ double LandmarkMap::meanReprojectionPx(const Landmark& lm, const PoseLookup& pos
 }
 
 int LandmarkMap::rejectOutliers(const PoseLookup& poses, const StereoGeometry& geometry,
-                                double max_px, double min_depth_m, double max_depth_m) {
+                                double t_d_s, double max_px, double min_depth_m,
+                                double max_depth_m) {
   int removed = 0;
   for (auto it = landmarks_.begin(); it != landmarks_.end();) {
     Landmark& lm = it->second;
@@ -176,7 +179,7 @@ int LandmarkMap::rejectOutliers(const PoseLookup& poses, const StereoGeometry& g
       ++it;
       continue;
     }
-    const Eigen::Vector3d p_w = worldPoint(lm, anchor_pose, geometry);
+    const Eigen::Vector3d p_w = worldPoint(lm, anchor_pose, geometry, t_d_s);
     bool anchor_bad = false;
     std::vector<Observation> kept;
     for (std::size_t k = 0; k < lm.observations.size(); ++k) {
@@ -185,12 +188,12 @@ int LandmarkMap::rejectOutliers(const PoseLookup& poses, const StereoGeometry& g
       bool good = pose != nullptr;
       if (good) {
         good = reprojectionErrorPx(geometry.left, cameraInWorld(pose, geometry.left), p_w,
-                                   o.px_left) <= max_px;
+                                   o.leftAt(t_d_s)) <= max_px;
       }
       Observation copy = o;
       if (good && o.has_right && geometry.stereo &&
           reprojectionErrorPx(geometry.right, cameraInWorld(pose, geometry.right), p_w,
-                              o.px_right) > max_px) {
+                              o.rightAt(t_d_s)) > max_px) {
         copy.has_right = false;  // keep the left observation, drop the bad stereo match
         ++removed;
       }

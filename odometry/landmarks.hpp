@@ -20,6 +20,17 @@ struct Observation {
   Eigen::Vector2d px_right = Eigen::Vector2d::Zero();
   Eigen::Vector2d velocity_pxps = Eigen::Vector2d::Zero();        // left image, px/s (tracker's)
   Eigen::Vector2d velocity_right_pxps = Eigen::Vector2d::Zero();  // right image
+
+  // Where the feature is at the frame's stamp when the stamps lag the exposures by t_d (s): the
+  // first-order shift z + t_d V of the time-offset factors (Qin and Shen 2018). Every geometric
+  // use of an observation (triangulation, outlier test, re-anchoring) must see the same pixel as
+  // the solver, or it rejects exactly the fast-moving features that make t_d observable.
+  [[nodiscard]] Eigen::Vector2d leftAt(double t_d_s) const {
+    return px_left + t_d_s * velocity_pxps;
+  }
+  [[nodiscard]] Eigen::Vector2d rightAt(double t_d_s) const {
+    return px_right + t_d_s * velocity_right_pxps;
+  }
 };
 
 struct Landmark {
@@ -58,28 +69,30 @@ class LandmarkMap {
   void create(std::uint64_t id, const Observation& obs, const StereoGeometry& geometry,
               double min_depth_m, double max_depth_m);
 
-  // World point of a landmark with depth.
+  // World point of a landmark with depth (its anchor pixel at the stamp for the time offset t_d).
   [[nodiscard]] static Eigen::Vector3d worldPoint(const Landmark& lm, const double* anchor_pose,
-                                                  const StereoGeometry& geometry);
+                                                  const StereoGeometry& geometry, double t_d_s);
   // Landmarks without depth (mono, or no stereo match) seen from two poses with enough parallax
   // get a depth by linear triangulation (DLT) of the anchor and latest observations.
-  void triangulate(const PoseLookup& poses, const StereoGeometry& geometry, double min_depth_m,
-                   double max_depth_m);
+  void triangulate(const PoseLookup& poses, const StereoGeometry& geometry, double t_d_s,
+                   double min_depth_m, double max_depth_m);
 
   // Removes every observation of a frame that leaves the window. Landmarks anchored there are
   // re-anchored to their next observation (depth carried over from the current estimate:
   // VINS-Mono's removeBackShiftDepth); landmarks left without observations are erased.
-  void removeFrame(std::uint64_t frame_uid, const PoseLookup& poses,
-                   const StereoGeometry& geometry);
+  void removeFrame(std::uint64_t frame_uid, const PoseLookup& poses, const StereoGeometry& geometry,
+                   double t_d_s);
+  // Every function taking t_d_s (the camera-IMU time offset, 0 when not estimated) measures the
+  // observations at the stamps, Observation::leftAt(t_d_s).
   // Drops observations whose reprojection error exceeds max_px (a bad anchor drops the landmark)
   // and depths out of range. Returns the number of observations removed.
-  int rejectOutliers(const PoseLookup& poses, const StereoGeometry& geometry, double max_px,
-                     double min_depth_m, double max_depth_m);
+  int rejectOutliers(const PoseLookup& poses, const StereoGeometry& geometry, double t_d_s,
+                     double max_px, double min_depth_m, double max_depth_m);
   // Mean reprojection error (px) of a landmark with depth over its window observations, left and
   // right images (a stereo match counts as a second observation); infinity when none can be
   // projected. The map's sparse filter (mapping::SparseConfig) uses it.
   [[nodiscard]] static double meanReprojectionPx(const Landmark& lm, const PoseLookup& poses,
-                                                 const StereoGeometry& geometry);
+                                                 const StereoGeometry& geometry, double t_d_s);
   // Number of landmarks with depth that are observed in frame_uid.
   [[nodiscard]] int countObservedWithDepth(std::uint64_t frame_uid) const;
   void clear() { landmarks_.clear(); }

@@ -316,6 +316,37 @@ std::shared_ptr<const MarginalizationPrior> Marginalizer::marginalize() const {
   return prior;
 }
 
+std::shared_ptr<const MarginalizationPrior> withRandomWalk(
+    const std::shared_ptr<const MarginalizationPrior>& prior, const double* block, int coordinate,
+    double variance, const MarginalizationOptions& options) {
+  if (!prior) throw InvalidInput("marginalization: random walk on a null prior");
+  const int index = prior->blockIndex(block);
+  if (index < 0) throw InvalidInput("marginalization: random walk on a block the prior lacks");
+  if (coordinate < 0 || coordinate >= prior->blocks[index].tangent_size) {
+    throw InvalidInput("marginalization: random walk coordinate outside the block");
+  }
+  if (!std::isfinite(variance) || variance < 0.0) {
+    throw InvalidInput("marginalization: random walk variance must be finite and >= 0");
+  }
+  if (variance == 0.0) return prior;
+  int column = coordinate;
+  for (int k = 0; k < index; ++k) column += prior->blocks[k].tangent_size;
+  const Eigen::MatrixXd H = prior->information();
+  const Eigen::VectorXd g = prior->J.transpose() * prior->r0;
+  const Eigen::VectorXd h = H.col(column);
+  const double s = H(column, column) + 1.0 / variance;
+  const Eigen::MatrixXd H_walked = H - h * h.transpose() / s;
+  const Eigen::VectorXd g_walked = g - h * (g(column) / s);
+  const Spectrum spectrum =
+      significantSpectrum(H_walked, std::max(H.diagonal().maxCoeff(), 0.0), options);
+  if (spectrum.s.size() == 0) return nullptr;
+  auto walked = std::make_shared<MarginalizationPrior>(*prior);
+  walked->J = spectrum.s.cwiseSqrt().asDiagonal() * spectrum.V.transpose();
+  walked->r0 =
+      spectrum.s.cwiseSqrt().cwiseInverse().asDiagonal() * (spectrum.V.transpose() * g_walked);
+  return walked;
+}
+
 MarginalizationFactor::MarginalizationFactor(std::shared_ptr<const MarginalizationPrior> prior)
     : prior_(std::move(prior)) {
   if (prior_ == nullptr) throw InvalidInput("marginalization: null prior");

@@ -120,6 +120,18 @@ class Marginalizer {
   std::vector<ResidualEntry> residuals_;
 };
 
+// The prior with a random walk of `variance` added to one tangent coordinate of a kept block
+// since its linearisation: the covariance becomes Sigma + q e e^T, i.e. by the Woodbury identity
+//   H' = H - h h^T / s,  g' = g - h (e^T g) / s,  h = H e,  s = e^T H e + 1/q,
+// the information the prior holds on that coordinate (and through it on the rest) decaying while
+// the mean stays (the prior's x0 is kept). Returns the prior unchanged for variance 0, nullptr
+// when no information is left. Throws
+// InvalidInput for a block the prior does not hold, a coordinate outside its tangent space or a
+// negative or non-finite variance.
+[[nodiscard]] std::shared_ptr<const MarginalizationPrior> withRandomWalk(
+    const std::shared_ptr<const MarginalizationPrior>& prior, const double* block, int coordinate,
+    double variance, const MarginalizationOptions& options = {});
+
 // The prior as a Ceres cost function. Parameter blocks are the prior's kept blocks in the order of
 // prior.blocks (possibly at new addresses: the estimator shifts its window), with their ambient
 // sizes. The Jacobian w.r.t. ambient x is J_block * MinusJacobian(x) (J_block for Euclidean

@@ -280,6 +280,11 @@ void SlidingWindow::marginalizeOldest(bool use_imu) {
     try {
       // Also replaces an old prior that did not involve the oldest frame (carried through).
       prior_ = (pose_named || prior_) ? m.marginalize() : nullptr;
+      if (with_time_offset && priorHoldsTimeOffset()) {
+        const double dt_s = static_cast<double>(next.t_ns - oldest.t_ns) * 1e-9;
+        const double sigma = config_.time_offset_random_walk_s;
+        prior_ = withRandomWalk(prior_, time_offset_s_.get(), 0, sigma * sigma * dt_s);
+      }
     } catch (const std::exception&) {
       // A degenerate linearisation (it should not happen) costs the prior, never the run.
       prior_.reset();
@@ -288,7 +293,7 @@ void SlidingWindow::marginalizeOldest(bool use_imu) {
     prior_.reset();
   }
   std::erase_if(anchors_, [&](const AnchorFactor& a) { return a.frame_uid == oldest.uid; });
-  landmarks_.removeFrame(oldest.uid, poseLookup(), geometry_);
+  landmarks_.removeFrame(oldest.uid, poseLookup(), geometry_, *time_offset_s_);
   frames_.pop_front();
 }
 
@@ -296,7 +301,7 @@ void SlidingWindow::dropNewest() {
   if (frames_.empty()) return;
   const std::uint64_t uid = frames_.back()->uid;
   std::erase_if(anchors_, [uid](const AnchorFactor& a) { return a.frame_uid == uid; });
-  landmarks_.removeFrame(uid, poseLookup(), geometry_);
+  landmarks_.removeFrame(uid, poseLookup(), geometry_, *time_offset_s_);
   frames_.pop_back();
 }
 

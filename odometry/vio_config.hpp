@@ -53,11 +53,16 @@ struct EstimatorConfig {
   double gyr_bias_prior_radps = 0.01;
   // Camera-IMU time offset t_d (how much image stamps lag the exposures, s) as a window state
   // (Qin and Shen 2018) when the IMU is in use; its prior around 0 (the calibration's timeshift
-  // is applied to the stamps before the estimator sees them). Off by default: on simulated drives
-  // a 20 ms lag is estimated as 8-17 ms after 10 s, and synchronised car drives settle 1-3 ms off
-  // (README, "Camera-IMU time offset").
+  // is applied to the stamps before the estimator sees them). Off by default: on car drives t_d is
+  // unobservable on straight stretches and the estimate wanders there by up to 10 ms (README,
+  // "Camera-IMU time offset").
   bool estimate_time_offset = false;
   double time_offset_sigma_s = 0.05;
+  // Random walk of t_d (s/sqrt(s)) added to its marginal at every marginalisation: on a car, t_d is
+  // unobservable while the motion is straight and steady (a lag then equals a shift along the
+  // track), and the information a long straight stretch appears to give (from model error) would
+  // otherwise hold the estimate where it was until long after the first turn. 0 keeps it all.
+  double time_offset_random_walk_s = 0.005;
 
   void validate() const;  // throws InvalidInput naming the field
 };

@@ -196,12 +196,13 @@ FrameResult VioEstimator::Impl::process(std::int64_t t_ns, const TrackedFrame& t
       event(t_ns, "initialized", "stereo window started (metric depth from the stereo pair)");
     }
   }
-  window.landmarks().triangulate(window.poseLookup(), geometry, config.min_depth_m,
-                                 config.max_depth_m);
+  window.landmarks().triangulate(window.poseLookup(), geometry, window.timeOffsetS(),
+                                 config.min_depth_m, config.max_depth_m);
 
   const SolveStats stats = window.solve(imuActive());
-  window.landmarks().rejectOutliers(window.poseLookup(), geometry, config.max_reprojection_px,
-                                    config.min_depth_m, config.max_depth_m);
+  window.landmarks().rejectOutliers(window.poseLookup(), geometry, window.timeOffsetS(),
+                                    config.max_reprojection_px, config.min_depth_m,
+                                    config.max_depth_m);
   if (usesImu(config.mode) && !imu_aligned && tryInitialize(t_ns, tracked)) {
     window.solve(true);
   }
@@ -360,9 +361,10 @@ std::vector<LandmarkEstimate> VioEstimator::landmarks() const {
     if (anchor == nullptr) continue;
     LandmarkEstimate e;
     e.id = id;
-    e.p_w = LandmarkMap::worldPoint(lm, anchor, w.geometry());
+    e.p_w = LandmarkMap::worldPoint(lm, anchor, w.geometry(), w.timeOffsetS());
     e.observations = static_cast<int>(lm.observations.size());
-    e.mean_reprojection_px = LandmarkMap::meanReprojectionPx(lm, poses, w.geometry());
+    e.mean_reprojection_px =
+        LandmarkMap::meanReprojectionPx(lm, poses, w.geometry(), w.timeOffsetS());
     out.push_back(e);
   }
   return out;

@@ -71,14 +71,16 @@ std::optional<Eigen::Isometry3d> VioEstimator::Impl::predictVisual(
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   const PoseLookup poses = window.poseLookup();
+  const double t_d = window.timeOffsetS();
   for (const Feature& f : tracked.features) {
     auto it = window.landmarks().all().find(f.id);
     if (it == window.landmarks().all().end() || !it->second.has_depth) continue;
     const double* anchor = poses(it->second.anchor().frame_uid);
     if (anchor == nullptr) continue;
-    const Eigen::Vector3d p_w = LandmarkMap::worldPoint(it->second, anchor, geometry);
+    const Eigen::Vector3d p_w = LandmarkMap::worldPoint(it->second, anchor, geometry, t_d);
     object.emplace_back(p_w.x(), p_w.y(), p_w.z());
-    image.emplace_back(f.px_left.x(), f.px_left.y());
+    const Eigen::Vector2d px = f.px_left + t_d * f.velocity_pxps;  // at the stamp
+    image.emplace_back(px.x(), px.y());
   }
   if (object.size() < static_cast<std::size_t>(kMinPnpPoints) || !latest.valid) return std::nullopt;
   const double guess_dt_s = static_cast<double>(tracked.t_ns - latest.t_ns) * 1e-9;

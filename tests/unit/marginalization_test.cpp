@@ -487,3 +487,55 @@ TEST(Marginalization, RemarginalizingPreviousPriorMatchesFullSchur) {
 
 }  // namespace
 }  // namespace gvio::odometry
+
+namespace gvio::odometry {
+namespace {
+
+// A prior on two Euclidean scalars a and b: r = r0 + J [da, db].
+std::shared_ptr<MarginalizationPrior> twoScalarPrior(const double* a, const double* b) {
+  auto p = std::make_shared<MarginalizationPrior>();
+  for (const double* block : {a, b}) {
+    MarginalizationPrior::Block blk;
+    blk.original_address = block;
+    blk.ambient_size = blk.tangent_size = 1;
+    blk.x0 = {*block};
+    p->blocks.push_back(blk);
+  }
+  p->J = upperTriangular(4.0, -1.5, 2.0);
+  p->r0 = Eigen::Vector2d(0.7, -0.3);
+  return p;
+}
+
+TEST(MarginalizationRandomWalk, AddsTheVarianceToOneCoordinateAndKeepsTheMean) {
+  const double a = 1.0, b = -2.0;
+  const auto prior = twoScalarPrior(&a, &b);
+  const double q = 0.09;
+  const auto walked = withRandomWalk(prior, &b, 0, q);
+  ASSERT_NE(walked, nullptr);
+  const Eigen::Matrix2d sigma = prior->information().inverse();
+  Eigen::Matrix2d expected = sigma;
+  expected(1, 1) += q;  // Sigma + q e_b e_b^T
+  const Eigen::Matrix2d sigma_walked = walked->information().inverse();
+  EXPECT_LT((sigma_walked - expected).norm(), 1e-12) << sigma_walked;
+  // The minimiser of |r0 + J dx|^2 (the prior's mean) does not move.
+  const Eigen::Vector2d mean = -prior->J.colPivHouseholderQr().solve(prior->r0);
+  const Eigen::Vector2d mean_walked =
+      -(walked->J.transpose() * walked->J).ldlt().solve(walked->J.transpose() * walked->r0);
+  EXPECT_LT((mean_walked - mean).norm(), 1e-12);
+  EXPECT_EQ(walked->blocks.size(), 2U);
+  EXPECT_EQ(walked->blocks[1].x0, prior->blocks[1].x0);
+}
+
+TEST(MarginalizationRandomWalk, ZeroVarianceKeepsThePriorAndBadRequestsThrow) {
+  const double a = 1.0, b = -2.0, c = 3.0;
+  const auto prior = twoScalarPrior(&a, &b);
+  EXPECT_EQ(withRandomWalk(prior, &a, 0, 0.0), prior);
+  EXPECT_THROW((void)withRandomWalk(prior, &c, 0, 1.0), InvalidInput);
+  EXPECT_THROW((void)withRandomWalk(prior, &a, 1, 1.0), InvalidInput);
+  EXPECT_THROW((void)withRandomWalk(prior, &a, 0, -1.0), InvalidInput);
+  EXPECT_THROW((void)withRandomWalk(prior, &a, 0, NAN), InvalidInput);
+  EXPECT_THROW((void)withRandomWalk(nullptr, &a, 0, 1.0), InvalidInput);
+}
+
+}  // namespace
+}  // namespace gvio::odometry

@@ -66,24 +66,48 @@ class LandmarkReprojection : public ::testing::Test {
 };
 
 TEST_F(LandmarkReprojection, ExactObservationsGiveZero) {
-  EXPECT_NEAR(LandmarkMap::meanReprojectionPx(landmark({0.0, 0.0}), poses(), geometry_), 0.0, 1e-9);
+  EXPECT_NEAR(LandmarkMap::meanReprojectionPx(landmark({0.0, 0.0}), poses(), geometry_, 0.0), 0.0,
+              1e-9);
 }
 
 TEST_F(LandmarkReprojection, OffsetCountsOverEveryImage) {
   // Three projections (anchor left, frame 2 left and right), one 3-4-5 px off: mean 5/3 px.
-  EXPECT_NEAR(LandmarkMap::meanReprojectionPx(landmark({3.0, 4.0}), poses(), geometry_), 5.0 / 3.0,
-              1e-9);
+  EXPECT_NEAR(LandmarkMap::meanReprojectionPx(landmark({3.0, 4.0}), poses(), geometry_, 0.0),
+              5.0 / 3.0, 1e-9);
 }
 
 TEST_F(LandmarkReprojection, NoDepthOrNoAnchorPoseIsInfinite) {
   Landmark lm = landmark({0.0, 0.0});
   blocks_.erase(2);
-  EXPECT_NEAR(LandmarkMap::meanReprojectionPx(lm, poses(), geometry_), 0.0, 1e-9);
+  EXPECT_NEAR(LandmarkMap::meanReprojectionPx(lm, poses(), geometry_, 0.0), 0.0, 1e-9);
   lm.has_depth = false;
-  EXPECT_TRUE(std::isinf(LandmarkMap::meanReprojectionPx(lm, poses(), geometry_)));
+  EXPECT_TRUE(std::isinf(LandmarkMap::meanReprojectionPx(lm, poses(), geometry_, 0.0)));
   lm.has_depth = true;
   blocks_.erase(1);
-  EXPECT_TRUE(std::isinf(LandmarkMap::meanReprojectionPx(lm, poses(), geometry_)));
+  EXPECT_TRUE(std::isinf(LandmarkMap::meanReprojectionPx(lm, poses(), geometry_, 0.0)));
+}
+
+// A camera whose stamps lag the exposures by t_d saw frame 2's feature t_d V earlier on its path:
+// measured at the stamps (Observation::leftAt) the observation is exact again, so the outlier test
+// keeps it, while read as stamped it is rejected.
+TEST_F(LandmarkReprojection, ObservationsAreMeasuredAtTheStampsForTheTimeOffset) {
+  const double t_d = 0.02;
+  const Eigen::Vector2d velocity(400.0, -150.0);  // px/s: 8 px and 3 px in 20 ms
+  Landmark lm = landmark({0.0, 0.0});
+  lm.observations[1].px_left -= t_d * velocity;
+  lm.observations[1].velocity_pxps = velocity;
+  lm.observations[1].has_right = false;
+  EXPECT_NEAR(LandmarkMap::meanReprojectionPx(lm, poses(), geometry_, t_d), 0.0, 1e-9);
+  EXPECT_NEAR(LandmarkMap::meanReprojectionPx(lm, poses(), geometry_, 0.0),
+              0.5 * (t_d * velocity).norm(), 1e-9);
+
+  const auto rejected = [&](double time_offset_s) {
+    LandmarkMap map;
+    map.all()[lm.id] = lm;
+    return map.rejectOutliers(poses(), geometry_, time_offset_s, 3.0, 0.5, 100.0);
+  };
+  EXPECT_EQ(rejected(t_d), 0);
+  EXPECT_EQ(rejected(0.0), 1);
 }
 
 }  // namespace
