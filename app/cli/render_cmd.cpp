@@ -7,6 +7,7 @@
 #include <regex>
 
 #include "cli/app.hpp"
+#include "cli/render_camera.hpp"
 #include "io/image_loader.hpp"
 #include "io/input_error.hpp"
 #include "io/run_dir.hpp"
@@ -21,6 +22,11 @@ namespace {
 struct RenderCliOptions {
   std::string run, out, view = "topdown", size = "1600x1200";
   std::optional<std::string> reference;
+  // --view camera
+  std::optional<double> at_s;
+  std::optional<std::string> dataset;
+  std::string overlay = "blend", map_colour = "depth";
+  double ahead_s = 20.0;
 };
 
 std::pair<int, int> parseSize(const std::string& text) {
@@ -69,6 +75,13 @@ cv::Mat toBgr(const render::ImageRgba& image) {
 }
 
 int runRender(const RenderCliOptions& o) {
+  if (o.view == "camera") {
+    if (!o.at_s) throw gvio::InvalidInput("--view camera needs --at T (seconds into the drive)");
+    CameraRenderRequest r{o.run, o.out, std::nullopt, *o.at_s, o.overlay, o.map_colour, o.ahead_s};
+    if (o.dataset) r.dataset = *o.dataset;
+    return renderCameraView(r);
+  }
+  if (o.at_s || o.dataset) throw gvio::InvalidInput("--at and --dataset are for --view camera");
   const viz::RunView view = viz::parseRunView(o.view);
   const auto [width, height] = parseSize(o.size);
   std::optional<std::filesystem::path> reference;
@@ -115,11 +128,22 @@ Command addRenderCommand(CLI::App& app) {
                   "map.pcd, map.ot / map.bt, gnss_fixes.csv, report.json, loops.csv)")
       ->required();
   sub->add_option("--view", o->view,
-                  "topdown (map), perspective (3-D cloud), octomap (voxels), or error (colour = "
-                  "APE against the truth)");
+                  "topdown (map), perspective (3-D cloud), octomap (voxels), error (colour = "
+                  "APE against the truth), or camera (the map over the recorded image at --at)");
   sub->add_option("--size", o->size, "Image size WxH (1..16384 px per side)");
   sub->add_option("--reference", o->reference,
                   "Ground truth file (TUM/KITTI/EuRoC) instead of groundtruth.tum");
+  sub->add_option("--at", o->at_s,
+                  "--view camera: seconds from the start of the trajectory (nearest image)");
+  sub->add_option("--overlay", o->overlay,
+                  "--view camera: blend (map over the image), edges (the map's outlines) or none "
+                  "(the map alone)");
+  sub->add_option("--map-colour", o->map_colour,
+                  "--view camera: depth (distance, jet) or intensity (the map's grey levels)");
+  sub->add_option("--ahead", o->ahead_s,
+                  "--view camera: seconds of trajectory ahead of the camera drawn (default 20)");
+  sub->add_option("--dataset", o->dataset,
+                  "--view camera: the dataset, if not where report.json's sources say");
   sub->add_option("--out", o->out, "Output PNG")->required();
   return {sub, [o] { return runRender(*o); }};
 }

@@ -117,18 +117,7 @@ std::vector<GnssFixRecord> readGnssFixes(const fs::path& file) {
 }
 
 std::vector<TimeSpan> readOutages(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file, 0, "cannot open for reading");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(file, lineOfByte(text, e.byte), "not valid JSON");
-  } catch (const nlohmann::json::exception& e) {  // e.g. a number too large for a double
-    throw InputError(file, 0, std::string("not valid JSON: ") + e.what());
-  }
-  if (!j.is_object()) throw InputError(file, 0, "expected a JSON object");
+  const nlohmann::json j = readJsonObject(file);
   std::vector<TimeSpan> spans;
   if (!j.contains("outages") || j["outages"].is_null()) return spans;
   const auto& a = j["outages"];
@@ -144,6 +133,22 @@ std::vector<TimeSpan> readOutages(const fs::path& file) {
     spans.push_back(s);
   }
   return spans;
+}
+
+nlohmann::json readJsonObject(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file, 0, "cannot open for reading");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(file, lineOfByte(text, e.byte), "not valid JSON");
+  } catch (const nlohmann::json::exception& e) {  // e.g. a number too large for a double
+    throw InputError(file, 0, std::string("not valid JSON: ") + e.what());
+  }
+  if (!j.is_object()) throw InputError(file, 0, "expected a JSON object");
+  return j;
 }
 
 std::optional<std::string> incompleteRunWarning(const fs::path& dir) {

@@ -10,6 +10,8 @@
 #include <optional>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "io/loops_csv.hpp"
 #include "odometry/trajectory.hpp"
 
@@ -74,6 +76,10 @@ struct RunReadOptions {
   bool outages = true;     // read report.json's outages when present
   bool loops = true;       // read loops.csv when present
 };
+
+// A JSON file whose top level is an object (report.json); InputError naming the file (and the
+// line of a syntax error) else.
+nlohmann::json readJsonObject(const std::filesystem::path& file);
 
 // A warning when `dir`/report.json says its run did not complete (status "running",
 // "interrupted" or "failed": gvio run's run/run_status.hpp), so files it had not replaced yet may

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include "io/atomic_write.hpp"
+#include "io/run_sources.hpp"
 #include "run/pipeline_stages.hpp"
 #include "run/report.hpp"
 #include "run/stats.hpp"
@@ -97,8 +98,11 @@ void writeReport(RunState& s) {
   context.gnss = s.gnss ? &*s.gnss : nullptr;
   context.evaluation_fused = e.fused ? &*e.fused : nullptr;
   context.evaluation_fused_online = e.fused_online ? &*e.fused_online : nullptr;
-  io::writeTextAtomic(s.request.out / "report.json",
-                      buildReport(s.dataset, s.vio, context).dump(2) + "\n");
+  nlohmann::json report = buildReport(s.dataset, s.vio, context);
+  report["sources"] = io::sourcesJson(
+      {s.request.dataset, s.request.format, s.request.calib_files, s.request.gnss_file},
+      s.dataset.format);
+  io::writeTextAtomic(s.request.out / "report.json", report.dump(2) + "\n");
   io::writeTextAtomic(s.request.out / "config.yaml", s.request.config_yaml);
   logSummary(s, e);
 }

@@ -22,6 +22,7 @@
 #include "io/nmea.hpp"
 #include "io/rtklib_pos.hpp"
 #include "io/run_dir.hpp"
+#include "io/run_sources.hpp"
 #include "io/trajectory_io.hpp"
 #include "support/fixtures.hpp"
 
@@ -114,6 +115,11 @@ constexpr const char* kReport =
     R"({"gvio_version":"0.1.0","outages":[{"t0_s":1.5,"t1_s":3.0}],"loops":{"accepted":1}})"
     "\n";
 
+constexpr const char* kReportSources =
+    R"({"mode":"stereo-imu","sources":{"dataset":"/data/drive","format":"euroc",)"
+    R"("calib_files":["/data/camchain.yaml","/data/imu.yaml"],"gnss_file":null}})"
+    "\n";
+
 constexpr const char* kGeoref =
     R"({"enu_origin":{"lat_deg":48.98253,"lon_deg":8.39035,"h_ellipsoid_m":116.4},)"
     R"("utm":{"zone":32,"north":true}})"
@@ -167,6 +173,11 @@ void addTextTargets(std::vector<Target>& out) {
   out.push_back(plain("report_json", "report.json", kReport, [](const fs::path& d) {
     for (const io::TimeSpan& s : io::readOutages(d / "report.json"))
       require(std::isfinite(s.t0_s) && std::isfinite(s.t1_s), "outage not finite");
+  }));
+  out.push_back(plain("report_sources", "report.json", kReportSources, [](const fs::path& d) {
+    const io::RunSources s = io::readRunSources(d / "report.json");
+    require(!s.mode.empty(), "empty mode accepted");
+    if (s.dataset) require(!s.dataset->dataset.empty() && s.dataset->format, "empty source");
   }));
   out.push_back(plain("georef_json", "georef.json", kGeoref, [](const fs::path& d) {
     const exporter::Georef g = exporter::readGeoref(d / "georef.json");
