@@ -44,26 +44,129 @@ std::size_t nearestFrame(const io::Dataset& ds, std::int64_t t_ns) {
 }
 
 // The dataset as the run opened it: its sources and its reader configuration (config.yaml).
-io::Dataset reopenDataset(const CameraRenderRequest& r, std::string& mode) {
-  const fs::path report = r.run / "report.json";
+io::Dataset reopenDataset(const fs::path& run_dir, const std::optional<fs::path>& dataset,
+                          std::string& mode) {
+  const fs::path report = run_dir / "report.json";
   const io::RunSources recorded = io::readRunSources(report);
   mode = recorded.mode;
-  if (!recorded.dataset && !r.dataset) {
+  if (!recorded.dataset && !dataset) {
     throw io::InputError(
         report, 0, "no \"sources\" (a run by an older gvio): name the dataset with --dataset");
   }
   io::DatasetSources sources = recorded.dataset.value_or(io::DatasetSources{});
-  if (r.dataset) {
-    sources.dataset = *r.dataset;
+  if (dataset) {
+    sources.dataset = *dataset;
     sources.format.reset();
   }
   ConfigSources config;
-  if (fs::exists(r.run / "config.yaml")) config.file = r.run / "config.yaml";
+  if (fs::exists(run_dir / "config.yaml")) config.file = run_dir / "config.yaml";
   const AppConfig app = loadConfig(config);
   return io::openDataset(sources, app.dataset);
 }
 
+bool stereoMode(const fs::path& run_dir, const std::string& mode) {
+  try {
+    return odometry::usesStereo(odometry::parseVioMode(mode));
+  } catch (const InvalidInput&) {
+    throw io::InputError(run_dir / "report.json", 0,
+                         "the run has no camera trajectory (mode \"" + mode + "\")");
+  }
+}
+
+io::RunFiles readMapRun(const fs::path& run_dir) {
+  if (const auto warning = io::incompleteRunWarning(run_dir)) spdlog::warn("{}", *warning);
+  io::RunReadOptions read;
+  read.occupancy = read.gnss_fixes = read.outages = read.loops = false;
+  io::RunFiles run = io::readRunDir(run_dir, read);
+  if (!viz::mapTrajectory(run).hasTimestamps()) {
+    throw io::InputError(run_dir, 0, "the trajectory has no timestamps");
+  }
+  return run;
+}
+
 }  // namespace
+
+struct RecordedCameraOverlay::State {
+  io::RunFiles run;
+  io::Dataset ds;
+  bool stereo = false;
+  std::optional<odometry::Rectifier> rectifier;
+  viz::CameraViewOptions options;
+  viz::OverlayMode overlay = viz::OverlayMode::kBlend;
+  render::PinholeIntrinsics K;
+  render::EglContext context;
+  render::Renderer renderer{context};
+  std::optional<render::Framebuffer> target;
+};
+
+RecordedCameraOverlay::RecordedCameraOverlay(const fs::path& run_dir,
+                                             const std::optional<fs::path>& dataset,
+                                             const viz::CameraViewOptions& options,
+                                             viz::OverlayMode overlay)
+    : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  s.run = readMapRun(run_dir);
+  std::string mode;
+  s.ds = reopenDataset(run_dir, dataset, mode);
+  if (s.ds.cameras.empty()) throw InvalidInput(s.ds.root.string() + ": no camera");
+  s.stereo = stereoMode(run_dir, mode) && s.ds.cameras.size() >= 2;
+  s.rectifier.emplace(s.ds.cameras[0],
+                      s.stereo ? std::optional<CameraModel>(s.ds.cameras[1]) : std::nullopt);
+  s.options = options;
+  s.overlay = overlay;
+  const CameraModel& cam = s.rectifier->left();
+  s.K.fx = cam.fx;
+  s.K.fy = cam.fy;
+  s.K.cx = cam.cx;
+  s.K.cy = cam.cy;
+  s.K.width = cam.width_px;
+  s.K.height = cam.height_px;
+  s.K.near_m = 0.3;
+  s.K.far_m = 2.0 * options.max_depth_m;
+  s.target.emplace(s.K.width, s.K.height);
+}
+
+RecordedCameraOverlay::~RecordedCameraOverlay() = default;
+
+const io::RunFiles& RecordedCameraOverlay::run() const {
+  return state_->run;
+}
+int RecordedCameraOverlay::width() const {
+  return state_->K.width;
+}
+int RecordedCameraOverlay::height() const {
+  return state_->K.height;
+}
+
+cv::Mat RecordedCameraOverlay::at(std::int64_t wanted_ns, std::string* frame_info) const {
+  State& s = *state_;
+  const std::size_t frame = nearestFrame(s.ds, wanted_ns);
+  const std::int64_t t_ns = s.ds.frames[frame].t_ns;
+  const cv::Mat raw_left = io::loadFrameImage(s.ds, frame, 0);
+  const cv::Mat raw_right = s.stereo ? io::loadFrameImage(s.ds, frame, 1) : cv::Mat();
+  const cv::Mat left = s.rectifier->rectify(raw_left, raw_right).left;
+  const auto T_map_c = viz::cameraPoseAt(s.run, t_ns, s.rectifier->left().T_b_c);
+  if (!T_map_c) {
+    throw InvalidInput(fmt::format("{}: the trajectory has no pose at {:.3f} s", s.run.dir.string(),
+                                   static_cast<double>(t_ns) * 1e-9));
+  }
+  const render::RenderCamera camera = render::pinholeCamera(s.K, *T_map_c);
+  const render::Scene scene = viz::cameraScene(s.run, camera, t_ns, s.options);
+  const render::GpuScene gpu(scene);
+  const render::ImageRgba image = s.renderer.renderColor(gpu, camera, *s.target);
+  cv::Mat out = viz::composeOverlay(image, left, s.overlay);
+  if (s.overlay == viz::OverlayMode::kEdges) {
+    viz::drawPath(out, camera, viz::pathAhead(s.run, t_ns, s.options.ahead_s));
+  }
+  if (frame_info != nullptr) {
+    std::size_t points = 0;
+    for (const auto& pc : scene.point_clouds) points += pc.points.size();
+    *frame_info =
+        fmt::format("camera at {:.3f} s, image {}: {} map points in view",
+                    static_cast<double>(t_ns) * 1e-9, io::imageSource(s.ds, frame, 0), points);
+  }
+  return out;
+}
 
 int renderCameraView(const CameraRenderRequest& r) {
   const viz::OverlayMode overlay = viz::parseOverlayMode(r.overlay);
@@ -72,69 +175,15 @@ int renderCameraView(const CameraRenderRequest& r) {
   if (!fs::is_directory(fs::absolute(r.out).parent_path())) {
     throw io::InputError(r.out, 0, "output folder does not exist");
   }
-  if (const auto warning = io::incompleteRunWarning(r.run)) spdlog::warn("{}", *warning);
-  io::RunReadOptions read;
-  read.occupancy = read.gnss_fixes = read.outages = read.loops = false;
-  const io::RunFiles run = io::readRunDir(r.run, read);
-  const Trajectory& traj = viz::mapTrajectory(run);
-  if (!traj.hasTimestamps()) throw io::InputError(r.run, 0, "the trajectory has no timestamps");
-  const std::int64_t wanted_ns = traj.t_ns.front() + static_cast<std::int64_t>(r.at_s * 1e9);
-
-  std::string mode;
-  const io::Dataset ds = reopenDataset(r, mode);
-  odometry::VioMode vio_mode{};
-  try {
-    vio_mode = odometry::parseVioMode(mode);
-  } catch (const InvalidInput&) {
-    throw io::InputError(r.run / "report.json", 0,
-                         "the run has no camera trajectory (mode \"" + mode + "\")");
-  }
-  const bool stereo = odometry::usesStereo(vio_mode) && ds.cameras.size() >= 2;
-  if (ds.cameras.empty()) throw InvalidInput(ds.root.string() + ": no camera");
-  const odometry::Rectifier rectifier(
-      ds.cameras[0], stereo ? std::optional<CameraModel>(ds.cameras[1]) : std::nullopt);
-  const std::size_t frame = nearestFrame(ds, wanted_ns);
-  const std::int64_t t_ns = ds.frames[frame].t_ns;
-  const cv::Mat raw_left = io::loadFrameImage(ds, frame, 0);
-  const cv::Mat raw_right = stereo ? io::loadFrameImage(ds, frame, 1) : cv::Mat();
-  const cv::Mat left = rectifier.rectify(raw_left, raw_right).left;
-
-  const CameraModel& cam = rectifier.left();
-  const auto T_map_c = viz::cameraPoseAt(run, t_ns, cam.T_b_c);
-  if (!T_map_c) {
-    throw InvalidInput(fmt::format("{}: the trajectory has no pose at {:.3f} s", r.run.string(),
-                                   static_cast<double>(t_ns) * 1e-9));
-  }
   viz::CameraViewOptions options;
   options.ahead_s = r.ahead_s;
   options.colour = viz::parseMapColour(r.map_colour);
-  render::PinholeIntrinsics K;
-  K.fx = cam.fx;
-  K.fy = cam.fy;
-  K.cx = cam.cx;
-  K.cy = cam.cy;
-  K.width = cam.width_px;
-  K.height = cam.height_px;
-  K.near_m = 0.3;
-  K.far_m = 2.0 * options.max_depth_m;
-  const render::RenderCamera camera = render::pinholeCamera(K, *T_map_c);
-  const render::Scene scene = viz::cameraScene(run, camera, t_ns, options);
-
-  const render::EglContext context;
-  const render::Renderer renderer(context);
-  render::Framebuffer target(K.width, K.height);
-  const render::GpuScene gpu(scene);
-  const render::ImageRgba image = renderer.renderColor(gpu, camera, target);
-  cv::Mat out = viz::composeOverlay(image, left, overlay);
-  if (overlay == viz::OverlayMode::kEdges) {
-    viz::drawPath(out, camera, viz::pathAhead(run, t_ns, options.ahead_s));
-  }
-  io::writePng(r.out, out);
-  std::size_t points = 0;
-  for (const auto& pc : scene.point_clouds) points += pc.points.size();
-  spdlog::info("wrote {} ({}x{}, camera at {:.3f} s, image {}): {} map points in view",
-               r.out.string(), K.width, K.height, static_cast<double>(t_ns) * 1e-9,
-               io::imageSource(ds, frame, 0), points);
+  const RecordedCameraOverlay overlayer(r.run, r.dataset, options, overlay);
+  const Trajectory& traj = viz::mapTrajectory(overlayer.run());
+  const std::int64_t wanted_ns = traj.t_ns.front() + static_cast<std::int64_t>(r.at_s * 1e9);
+  std::string info;
+  io::writePng(r.out, overlayer.at(wanted_ns, &info));
+  spdlog::info("wrote {} ({}x{}, {})", r.out.string(), overlayer.width(), overlayer.height(), info);
   return 0;
 }
 
