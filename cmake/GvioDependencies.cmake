@@ -2,7 +2,7 @@
 # Nothing is downloaded at configure or build time.
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)
 find_package(Ceres REQUIRED)
-find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs video calib3d features2d)
+find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs video videoio calib3d features2d)
 # PCL's optional VTK dependency (visualisation only) drags in VTK's MPI targets, which Debian's
 # VTK config cannot resolve without MPI; gvio never includes VTK headers, so skip it.
 set(CMAKE_DISABLE_FIND_PACKAGE_VTK ON)

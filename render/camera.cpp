@@ -86,17 +86,9 @@ RenderCamera topDownCamera(const Eigen::AlignedBox3d& bounds, int width, int hei
   return cam;
 }
 
-RenderCamera orbitCamera(const Eigen::AlignedBox3d& bounds, int width, int height,
-                         double azimuth_deg, double elevation_deg, double fov_y_deg) {
-  const Eigen::AlignedBox3d b = nonEmpty(bounds);
-  const double radius = 0.5 * b.sizes().norm();
-  const double fov = fov_y_deg * M_PI / 180.0, az = azimuth_deg * M_PI / 180.0,
-               el = elevation_deg * M_PI / 180.0;
-  const double distance = radius / std::sin(0.5 * std::min(fov, fov * width / height));
-  const Eigen::Vector3d target = b.center();
-  const Eigen::Vector3d eye =
-      target + distance * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az),
-                                          std::sin(el));
+RenderCamera lookAtCamera(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, int width,
+                          int height, double fov_y_deg, double near_m, double far_m) {
+  if (!((target - eye).norm() > 0.0)) throw RenderError("lookAtCamera: eye and target coincide");
   // Camera axes: z towards the target, x to the right, y down (world up is +z).
   const Eigen::Vector3d z = (target - eye).normalized();
   Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ());
@@ -109,13 +101,28 @@ RenderCamera orbitCamera(const Eigen::AlignedBox3d& bounds, int width, int heigh
   PinholeIntrinsics K;
   K.width = width;
   K.height = height;
-  K.fy = 0.5 * height / std::tan(0.5 * fov);
+  K.fy = 0.5 * height / std::tan(0.5 * fov_y_deg * M_PI / 180.0);
   K.fx = K.fy;
   K.cx = 0.5 * width - 0.5;
   K.cy = 0.5 * height - 0.5;
-  K.near_m = std::max(0.01, distance - 2.0 * radius);
-  K.far_m = distance + 2.0 * radius;
+  K.near_m = near_m;
+  K.far_m = far_m;
   return pinholeCamera(K, T_w_c);
+}
+
+RenderCamera orbitCamera(const Eigen::AlignedBox3d& bounds, int width, int height,
+                         double azimuth_deg, double elevation_deg, double fov_y_deg) {
+  const Eigen::AlignedBox3d b = nonEmpty(bounds);
+  const double radius = 0.5 * b.sizes().norm();
+  const double fov = fov_y_deg * M_PI / 180.0, az = azimuth_deg * M_PI / 180.0,
+               el = elevation_deg * M_PI / 180.0;
+  const double distance = radius / std::sin(0.5 * std::min(fov, fov * width / height));
+  const Eigen::Vector3d target = b.center();
+  const Eigen::Vector3d eye =
+      target + distance * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az),
+                                          std::sin(el));
+  return lookAtCamera(eye, target, width, height, fov_y_deg,
+                      std::max(0.01, distance - 2.0 * radius), distance + 2.0 * radius);
 }
 
 Eigen::Vector2d projectToPixel(const RenderCamera& camera, const Eigen::Vector3d& p_w,

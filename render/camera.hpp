@@ -31,6 +31,11 @@ RenderCamera pinholeCamera(const PinholeIntrinsics& K, const Eigen::Isometry3d& 
 RenderCamera topDownCamera(const Eigen::AlignedBox3d& bounds, int width, int height,
                            double margin = 0.05);
 
+// Perspective camera at `eye` looking at `target`, image x to the right and y down with world up
+// +z (a view straight up or down takes +x as its image x), square pixels, principal point at the
+// image centre. Throws RenderError for eye == target or invalid sizes.
+RenderCamera lookAtCamera(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, int width,
+                          int height, double fov_y_deg, double near_m, double far_m);
 // Perspective view orbiting the centre of `bounds` (azimuth from +x towards +y, elevation above
 // the x-y plane), far enough that the bounding sphere fits the vertical field of view.
 RenderCamera orbitCamera(const Eigen::AlignedBox3d& bounds, int width, int height,

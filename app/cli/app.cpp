@@ -105,7 +105,7 @@ int runMain(int argc, char** argv) {
   std::vector<Command> commands;
   commands.push_back(addInspectCommand(app, common));
   commands.push_back(addEvalCommand(app));
-  commands.push_back(addRenderCommand(app));
+  commands.push_back(addRenderCommand(app, common));
   commands.push_back(addSimulateCommand(app, common));
   commands.push_back(addRunCommand(app, common));
   commands.push_back(addExportCommand(app));

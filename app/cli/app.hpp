@@ -38,7 +38,7 @@ struct Command {
 
 Command addInspectCommand(CLI::App& app, const CommonOptions& common);
 Command addEvalCommand(CLI::App& app);
-Command addRenderCommand(CLI::App& app);
+Command addRenderCommand(CLI::App& app, const CommonOptions& common);
 Command addSimulateCommand(CLI::App& app, const CommonOptions& common);
 Command addRunCommand(CLI::App& app, const CommonOptions& common);
 Command addExportCommand(CLI::App& app);

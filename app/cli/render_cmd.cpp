@@ -8,6 +8,7 @@
 
 #include "cli/app.hpp"
 #include "cli/render_camera.hpp"
+#include "cli/render_video.hpp"
 #include "io/image_loader.hpp"
 #include "io/input_error.hpp"
 #include "io/run_dir.hpp"
@@ -27,6 +28,10 @@ struct RenderCliOptions {
   std::optional<std::string> dataset;
   std::string overlay = "blend", map_colour = "depth";
   double ahead_s = 20.0;
+  // --video
+  std::optional<std::string> video;
+  double fps = 10.0, speed = 1.0;
+  bool size_given = false;
 };
 
 std::pair<int, int> parseSize(const std::string& text) {
@@ -74,7 +79,28 @@ cv::Mat toBgr(const render::ImageRgba& image) {
   return bgr;
 }
 
-int runRender(const RenderCliOptions& o) {
+int runVideo(const RenderCliOptions& o, ProgressStyle progress) {
+  if (o.at_s) throw gvio::InvalidInput("--at is for a still image, not --video");
+  VideoRequest r;
+  r.run = o.run;
+  r.out = *o.video;
+  r.view = o.view;
+  std::tie(r.width, r.height) = parseSize(o.size_given ? o.size : "1280x720");
+  r.fps = o.fps;
+  r.speed = o.speed;
+  if (o.dataset) r.dataset = *o.dataset;
+  r.overlay = o.overlay;
+  r.map_colour = o.map_colour;
+  r.progress = progress;
+  return renderVideo(r);
+}
+
+int runRender(const RenderCliOptions& o, ProgressStyle progress) {
+  if (o.video) {
+    if (!o.out.empty()) throw gvio::InvalidInput("--video writes the video: no --out with it");
+    return runVideo(o, progress);
+  }
+  if (o.out.empty()) throw gvio::InvalidInput("--out is required (or --video FILE)");
   if (o.view == "camera") {
     if (!o.at_s) throw gvio::InvalidInput("--view camera needs --at T (seconds into the drive)");
     CameraRenderRequest r{o.run, o.out, std::nullopt, *o.at_s, o.overlay, o.map_colour, o.ahead_s};
@@ -119,7 +145,7 @@ int runRender(const RenderCliOptions& o) {
 
 }  // namespace
 
-Command addRenderCommand(CLI::App& app) {
+Command addRenderCommand(CLI::App& app, const CommonOptions& common) {
   auto o = std::make_shared<RenderCliOptions>();
   CLI::App* sub =
       app.add_subcommand("render", "Draw a run's map and trajectories off-screen (EGL) into a PNG");
@@ -130,7 +156,9 @@ Command addRenderCommand(CLI::App& app) {
   sub->add_option("--view", o->view,
                   "topdown (map), perspective (3-D cloud), octomap (voxels), error (colour = "
                   "APE against the truth), or camera (the map over the recorded image at --at)");
-  sub->add_option("--size", o->size, "Image size WxH (1..16384 px per side)");
+  sub->add_option("--size", o->size,
+                  "Image size WxH (1..16384 px per side; videos: 1280x720 unless given)")
+      ->each([o](const std::string&) { o->size_given = true; });
   sub->add_option("--reference", o->reference,
                   "Ground truth file (TUM/KITTI/EuRoC) instead of groundtruth.tum");
   sub->add_option("--at", o->at_s,
@@ -144,8 +172,14 @@ Command addRenderCommand(CLI::App& app) {
                   "--view camera: seconds of trajectory ahead of the camera drawn (default 20)");
   sub->add_option("--dataset", o->dataset,
                   "--view camera: the dataset, if not where report.json's sources say");
-  sub->add_option("--out", o->out, "Output PNG")->required();
-  return {sub, [o] { return runRender(*o); }};
+  sub->add_option("--video", o->video,
+                  "Write a video along the drive instead (.mp4 H.264, .avi MJPEG) of --view "
+                  "follow (chase camera), topdown (the map growing) or camera");
+  sub->add_option("--fps", o->fps, "--video: frames per second of video (default 10)");
+  sub->add_option("--speed", o->speed,
+                  "--video: seconds of drive per second of video (default 1: real time)");
+  sub->add_option("--out", o->out, "Output PNG");
+  return {sub, [o, &common] { return runRender(*o, common.progressStyle()); }};
 }
 
 }  // namespace gvio::cli

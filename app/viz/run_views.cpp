@@ -312,6 +312,20 @@ io::RunReadOptions readOptionsFor(RunView view,
   return o;
 }
 
+ViewSpec buildTopDownMapOnly(io::RunFiles run, int width, int height) {
+  run.truth.reset();
+  run.loops.reset();
+  run.outages.clear();
+  ViewSpec v = buildRunView(run, RunView::kTopDown, width, height);
+  v.scene.polylines.clear();
+  std::erase_if(v.annotations.legend, [](const render::LegendEntry& e) {
+    return e.label == "VIO (own world frame)" || e.label == "fused (ENU)";
+  });
+  v.annotations.legend.insert(v.annotations.legend.begin(),
+                              {"path driven", render::Rgb{0.95F, 0.1F, 0.75F}, false});
+  return v;
+}
+
 double metresPerPixelAt(const render::RenderCamera& camera, const Eigen::Vector3d& p_w) {
   if (!camera.perspective) return camera.metres_per_pixel;
   const double depth = (camera.view * p_w.homogeneous()).z();

@@ -37,6 +37,11 @@ struct ViewSpec {
 // octomap view without map.ot / map.bt or without occupied voxels).
 ViewSpec buildRunView(const io::RunFiles& run, RunView view, int width, int height);
 
+// The top-down view without its lines (trajectories, GNSS outages, loop closures) and their legend
+// entries, plus a legend entry for the path a video draws as it grows: the map for
+// `gvio render --video --view topdown`.
+ViewSpec buildTopDownMapOnly(io::RunFiles run, int width, int height);
+
 // Metres one pixel spans at `p_w` (perspective: at its depth; orthographic: everywhere).
 double metresPerPixelAt(const render::RenderCamera& camera, const Eigen::Vector3d& p_w);
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -155,6 +156,86 @@ TEST_F(CliRenderCamera, BadRequestsExitTwoWithOneLine) {
   EXPECT_THAT(r.err, HasSubstr("--dataset"));
   r = runGvio(old_args + " --dataset " + quoted(dataset_));
   EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
+}  // namespace
+}  // namespace gvio::test
+
+namespace gvio::test {
+namespace {
+
+struct VideoFile {
+  int frames = 0, width = 0, height = 0;
+  cv::Mat first, last;
+};
+
+VideoFile readVideo(const std::string& file) {
+  cv::VideoCapture capture(file);
+  VideoFile v;
+  cv::Mat frame;
+  while (capture.read(frame)) {
+    if (v.frames == 0) v.first = frame.clone();
+    v.last = frame.clone();
+    ++v.frames;
+  }
+  v.width = v.first.cols;
+  v.height = v.first.rows;
+  return v;
+}
+
+double whiteShare(const cv::Mat& bgr) {
+  cv::Mat grey;
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  return cv::countNonZero(grey > 245) / static_cast<double>(grey.total());
+}
+
+// At 4x speed and 10 fps a frame every 0.4 s of the drive, from its first pose to its last.
+TEST_F(CliRenderCamera, VideosOfEveryViewHaveOneFramePerStepOfTheDrive) {
+  const Trajectory vio = io::readTum(run() / "trajectory_vio.tum");
+  const int expected =
+      static_cast<int>(static_cast<double>(vio.t_ns.back() - vio.t_ns.front()) * 1e-9 / 0.4) + 1;
+  ASSERT_GT(expected, 10);
+  const std::string base = "render --run " + quoted(run()) + " --speed 4 --no-progress";
+  CommandResult r = runGvio(base + " --view follow --size 320x240 --video " + out("f.mp4"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const VideoFile follow = readVideo(out("f.mp4"));
+  EXPECT_EQ(follow.frames, expected);
+  EXPECT_EQ(follow.width, 320);
+  EXPECT_EQ(follow.height, 240);
+
+  r = runGvio(base + " --view topdown --size 320x240 --video " + out("t.avi"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const VideoFile top = readVideo(out("t.avi"));
+  EXPECT_EQ(top.frames, expected);
+  // The map is revealed as the drive goes on.
+  EXPECT_GT(whiteShare(top.first), whiteShare(top.last) + 0.05);
+
+  r = runGvio(base + " --view camera --overlay edges --video " + out("c.mp4"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const VideoFile camera = readVideo(out("c.mp4"));
+  EXPECT_EQ(camera.frames, expected);
+  EXPECT_EQ(camera.width, 1242);  // 1241 px padded to even for H.264's 4:2:0
+  EXPECT_EQ(camera.height, 376);
+  EXPECT_FALSE(fs::exists(out("c.mp4") + ".tmp"));
+  for (const auto& e : fs::directory_iterator(dir_->path())) {
+    EXPECT_EQ(e.path().filename().string().find("gvio-tmp"), std::string::npos) << e.path();
+  }
+}
+
+TEST_F(CliRenderCamera, BadVideoRequestsExitTwo) {
+  const std::string base = "render --run " + quoted(run()) + " --view follow --no-progress";
+  CommandResult r = runGvio(base + " --video " + out("v.gif"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("unknown video container"));
+  r = runGvio(base + " --video " + out("v.mp4") + " --fps 0");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--fps"));
+  r = runGvio(base + " --video " + out("v.mp4") + " --out " + out("v.png"));
+  EXPECT_EQ(r.exit_code, 2);
+  r = runGvio("render --run " + quoted(run()) + " --video " + out("v.mp4") + " --view sideways");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("expected follow, topdown or camera"));
+  EXPECT_FALSE(fs::exists(out("v.mp4")));
 }
 
 }  // namespace

@@ -1,0 +1,52 @@
+#pragma once
+// `gvio render --video`: the frames of a video along the drive. Pure functions of the run's data
+// and the cameras; the CLI renders, encodes and writes.
+//  - follow:  a chase camera behind and above the body, the whole map and trajectory, the body
+//             as a disc;
+//  - topdown: the top-down map revealed where the drive has been so far (within reveal_m of the
+//             path driven), the path growing, the body as a disc;
+//  - camera:  the map over the recorded camera image (viz/camera_view.hpp), frame by frame.
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "odometry/trajectory.hpp"
+#include "render/camera.hpp"
+#include "render/image.hpp"
+
+namespace gvio::viz {
+
+enum class VideoView { kFollow, kTopDown, kCamera };
+VideoView parseVideoView(const std::string& name);  // InvalidInput for anything else
+
+// The instants of the video's frames: from the trajectory's first stamp to its last, one every
+// speed / fps seconds of the drive (the video then plays `speed` times faster than the drive).
+// InvalidInput for fps or speed not > 0 or a trajectory without stamps.
+std::vector<std::int64_t> videoFrameTimes(const Trajectory& traj, double fps, double speed);
+
+// A chase camera: 14 m behind the body along its heading (the body x axis on the ground plane),
+// 7 m above it, looking at a point 10 m ahead; 60 degrees vertical field of view.
+render::RenderCamera chaseCamera(const Eigen::Isometry3d& T_w_b, int width, int height);
+
+// The positions of the trajectory up to and including t_ns.
+std::vector<Eigen::Vector3d> pathUntil(const Trajectory& traj, std::int64_t t_ns);
+
+// The top-down map (`full`, RGBA, rendered once for the whole drive) where the path so far has
+// passed within reveal_m, white elsewhere; RGBA, so annotations can still be drawn on it.
+render::ImageRgba revealedAlongPath(const render::ImageRgba& full,
+                                    const render::RenderCamera& camera,
+                                    const std::vector<Eigen::Vector3d>& path, double reveal_m);
+
+// The path (BGR magenta line, broken behind the camera) and the body as a disc at its end.
+void drawDrive(cv::Mat& bgr, const render::RenderCamera& camera,
+               const std::vector<Eigen::Vector3d>& path);
+// "t = 12.3 s" in the top-left corner.
+void drawDriveTime(cv::Mat& bgr, double drive_time_s);
+
+// The trajectory's pose at t_ns: interpolated, else (in a gap) the last pose before it.
+Eigen::Isometry3d poseAt(const Trajectory& traj, std::int64_t t_ns);
+
+}  // namespace gvio::viz
