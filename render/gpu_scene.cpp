@@ -187,10 +187,11 @@ void GpuScene::uploadLines(const Scene& scene) {
 
 void GpuScene::uploadPoints(const Scene& scene) {
   std::vector<StyledVertex> v;
-  for (const auto& c : scene.point_clouds) {
+  for (std::size_t k = 0; k < scene.point_clouds.size(); ++k) {
+    const PointCloud& c = scene.point_clouds[k];
     if (c.points.empty()) continue;
     point_ranges_.push_back(
-        {static_cast<GLint>(v.size()), static_cast<GLsizei>(c.points.size()), c.round});
+        {static_cast<GLint>(v.size()), static_cast<GLsizei>(c.points.size()), c.round, k});
     for (std::size_t i = 0; i < c.points.size(); ++i) {
       v.push_back(styled(c.points[i], origin_,
                          pick(c.colors, i, c.points.size(), kWhite, "point colours"),

@@ -81,6 +81,10 @@ void Renderer::draw(const GpuScene& s, const RenderCamera& camera, Framebuffer& 
     setMvp(points_.get(), mvp);
     glBindVertexArray(s.point_vao_.get());
     for (const auto& r : s.point_ranges_) {
+      if (!options.point_clouds.empty() &&
+          (r.source >= options.point_clouds.size() || !options.point_clouds[r.source])) {
+        continue;
+      }
       glUniform1i(glGetUniformLocation(points_.get(), "u_round"), r.round ? 1 : 0);
       glDrawArrays(GL_POINTS, r.first, r.count);
     }

@@ -32,6 +32,7 @@ class GpuScene {
     GLint first = 0;
     GLsizei count = 0;
     bool round = true;
+    std::size_t source = 0;  // index of the point cloud (or polyline) in the Scene
   };
   struct Voxels {
     GlVertexArray vao;
@@ -66,6 +67,9 @@ class GpuScene {
 
 struct DrawOptions {
   float exposure_gain = 1.0F;  // multiplies mesh texture intensities
+  // Which of the scene's point clouds to draw (Scene::point_clouds order); empty: all. A large map
+  // uploaded once as tiles draws only the tiles near the camera this way (render --video).
+  std::vector<bool> point_clouds;
 };
 
 class Renderer {

@@ -28,6 +28,10 @@ namespace fs = std::filesystem;
 
 // The top-down video reveals the map within this distance of the path driven so far.
 constexpr double kRevealM = 40.0;
+// The follow video draws the map's ground tiles of this side within this distance of its camera.
+constexpr double kTileM = 32.0;
+constexpr double kDrawRadiusM = 120.0;
+constexpr double kTrailS = 20.0;  // the follow video's path: the last 20 s
 
 cv::Mat toBgr(const render::ImageRgba& image) {
   cv::Mat rgba(image.height, image.width, CV_8UC4, const_cast<std::uint8_t*>(image.rgba.data())),
@@ -86,11 +90,13 @@ double driveTimeS(const Trajectory& traj, std::int64_t t_ns) {
   return static_cast<double>(t_ns - traj.t_ns.front()) * 1e-9;
 }
 
-// The whole map and trajectory from a chase camera that follows the body.
+// The whole map and trajectory from a chase camera that follows the body. The map is uploaded
+// once, in ground tiles, and each frame draws the tiles near and ahead of the camera.
 int followVideo(const VideoRequest& r, const io::RunFiles& run) {
   const Trajectory& traj = viz::mapTrajectory(run);
   const auto times = viz::videoFrameTimes(traj, r.fps, r.speed);
   render::Scene scene;
+  std::vector<Eigen::Vector3d> centres;
   if (run.cloud && !run.cloud->p_enu.empty()) {
     const Eigen::AlignedBox3d q = viz::quantileBounds(run.cloud->p_enu);
     viz::CloudStyle style;
@@ -99,7 +105,13 @@ int followVideo(const VideoRequest& r, const io::RunFiles& run) {
     style.shade_by_intensity = true;
     style.size_px = 2.0F;
     const auto dense = viz::densePointIndices(run.cloud.value());
-    scene.point_clouds.push_back(viz::colouredCloud(*run.cloud, style, &dense));
+    std::vector<Eigen::Vector3f> dense_p;
+    dense_p.reserve(dense.size());
+    for (const std::uint32_t i : dense) dense_p.push_back(run.cloud->p_enu[i]);
+    for (auto& tile : viz::groundTiles(dense_p, kTileM, centres)) {
+      for (std::uint32_t& i : tile) i = dense[i];
+      scene.point_clouds.push_back(viz::colouredCloud(*run.cloud, style, &tile));
+    }
   }
   render::Polyline path;
   for (const auto& T : traj.poses) path.points.push_back(T.translation());
@@ -109,11 +121,15 @@ int followVideo(const VideoRequest& r, const io::RunFiles& run) {
   const render::Renderer renderer(context);
   render::Framebuffer target(r.width, r.height);
   const render::GpuScene gpu(scene);
+  render::DrawOptions draw;
   encode(r, times, r.width, r.height, [&](std::int64_t t_ns) {
     const Eigen::Isometry3d T_w_b = viz::poseAt(traj, t_ns);
     const render::RenderCamera camera = viz::chaseCamera(T_w_b, r.width, r.height);
-    cv::Mat bgr = toBgr(renderer.renderColor(gpu, camera, target));
-    viz::drawDrive(bgr, camera, viz::pathUntil(traj, t_ns));
+    draw.point_clouds = viz::tilesInView(centres, camera, kDrawRadiusM, kTileM);
+    cv::Mat bgr = toBgr(renderer.renderColor(gpu, camera, target, draw));
+    // The recent trail only: the line is drawn over the image, not depth-tested, and the drive's
+    // far earlier parts would cross buildings in front of them.
+    viz::drawDrive(bgr, camera, viz::pathUntil(traj, t_ns, kTrailS));
     viz::drawDriveTime(bgr, driveTimeS(traj, t_ns));
     return bgr;
   });

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <map>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
 
@@ -54,10 +56,50 @@ render::RenderCamera chaseCamera(const Eigen::Isometry3d& T_w_b, int width, int 
                               2000.0);
 }
 
-std::vector<Eigen::Vector3d> pathUntil(const Trajectory& traj, std::int64_t t_ns) {
+std::vector<std::vector<std::uint32_t>> groundTiles(const std::vector<Eigen::Vector3f>& p,
+                                                    double tile_m,
+                                                    std::vector<Eigen::Vector3d>& centres) {
+  std::map<std::pair<std::int64_t, std::int64_t>, std::vector<std::uint32_t>> tiles;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!p[i].allFinite()) continue;
+    const auto key = std::make_pair(
+        static_cast<std::int64_t>(std::floor(static_cast<double>(p[i].y()) / tile_m)),
+        static_cast<std::int64_t>(std::floor(static_cast<double>(p[i].x()) / tile_m)));
+    tiles[key].push_back(static_cast<std::uint32_t>(i));
+  }
+  std::vector<std::vector<std::uint32_t>> out;
+  centres.clear();
+  for (auto& [key, indices] : tiles) {
+    double z = 0.0;
+    for (const std::uint32_t i : indices) z += static_cast<double>(p[i].z());
+    centres.emplace_back((static_cast<double>(key.second) + 0.5) * tile_m,
+                         (static_cast<double>(key.first) + 0.5) * tile_m,
+                         z / static_cast<double>(indices.size()));
+    out.push_back(std::move(indices));
+  }
+  return out;
+}
+
+std::vector<bool> tilesInView(const std::vector<Eigen::Vector3d>& centres,
+                              const render::RenderCamera& camera, double radius_m, double tile_m) {
+  const Eigen::Isometry3d T_w_c(camera.view.inverse());
+  const Eigen::Vector3d eye = T_w_c.translation();
+  const Eigen::Vector3d forward = T_w_c.rotation().col(2);
+  const double slack = tile_m * M_SQRT1_2;
+  std::vector<bool> in(centres.size());
+  for (std::size_t k = 0; k < centres.size(); ++k) {
+    const Eigen::Vector3d d = centres[k] - eye;
+    in[k] = d.norm() <= radius_m + slack && d.dot(forward) >= -slack;
+  }
+  return in;
+}
+
+std::vector<Eigen::Vector3d> pathUntil(const Trajectory& traj, std::int64_t t_ns, double window_s) {
   std::vector<Eigen::Vector3d> path;
   for (std::size_t i = 0; i < traj.size() && i < traj.t_ns.size() && traj.t_ns[i] <= t_ns; ++i) {
-    path.push_back(traj.poses[i].translation());
+    if (static_cast<double>(t_ns - traj.t_ns[i]) * 1e-9 <= window_s) {
+      path.push_back(traj.poses[i].translation());
+    }
   }
   return path;
 }

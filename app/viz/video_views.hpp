@@ -7,6 +7,7 @@
 //             path driven), the path growing, the body as a disc;
 //  - camera:  the map over the recorded camera image (viz/camera_view.hpp), frame by frame.
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -31,8 +32,19 @@ std::vector<std::int64_t> videoFrameTimes(const Trajectory& traj, double fps, do
 // 7 m above it, looking at a point 10 m ahead; 60 degrees vertical field of view.
 render::RenderCamera chaseCamera(const Eigen::Isometry3d& T_w_b, int width, int height);
 
-// The positions of the trajectory up to and including t_ns.
-std::vector<Eigen::Vector3d> pathUntil(const Trajectory& traj, std::int64_t t_ns);
+// The points in square tiles of side tile_m on the ground plane (x-y), as index lists in a fixed
+// order (by tile row, then column); `centres` gets each tile's centre (mean height of its points).
+std::vector<std::vector<std::uint32_t>> groundTiles(const std::vector<Eigen::Vector3f>& p,
+                                                    double tile_m,
+                                                    std::vector<Eigen::Vector3d>& centres);
+// Which tiles a perspective camera can show: centre within radius_m of the camera and not behind
+// it (a tile's half diagonal of slack).
+std::vector<bool> tilesInView(const std::vector<Eigen::Vector3d>& centres,
+                              const render::RenderCamera& camera, double radius_m, double tile_m);
+
+// The positions of the trajectory up to and including t_ns (from t_ns - window_s when given).
+std::vector<Eigen::Vector3d> pathUntil(const Trajectory& traj, std::int64_t t_ns,
+                                       double window_s = INFINITY);
 
 // The top-down map (`full`, RGBA, rendered once for the whole drive) where the path so far has
 // passed within reveal_m, white elsewhere; RGBA, so annotations can still be drawn on it.

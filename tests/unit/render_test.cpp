@@ -176,6 +176,40 @@ TEST_F(RenderTest, ColourAndDepthReadback) {
   EXPECT_EQ(renderer_->renderDepth(empty, cam, fb).at(5, 5), 0.0F);
 }
 
+// DrawOptions::point_clouds draws only the clouds asked for (an empty cloud before them keeps the
+// numbering: it is the scene's index that counts).
+TEST_F(RenderTest, PointCloudMaskDrawsOnlyTheChosenClouds) {
+  Scene scene;
+  scene.background = Color(0, 0, 0, 1);
+  scene.point_clouds.emplace_back();  // empty
+  for (const double x : {-2.0, 2.0}) {
+    PointCloud c;
+    c.points = {{x, 0.0, 10.0}};
+    c.colors = {Color(1, 1, 1, 1)};
+    c.sizes_px = {9.0F};
+    scene.point_clouds.push_back(c);
+  }
+  const GpuScene gpu(scene);
+  PinholeIntrinsics K = kittiCamera();
+  K.width = 160;
+  K.height = 120;
+  K.fx = K.fy = 100.0;
+  K.cx = 79.5;
+  K.cy = 59.5;
+  const RenderCamera cam = pinholeCamera(K, Eigen::Isometry3d::Identity());
+  Framebuffer fb(K.width, K.height);
+  const auto lit = [](const ImageRgba& img, int x) { return img.pixel(x, 60)[0] > 128; };
+  // x = -2 m and +2 m at 10 m: columns 79.5 -+ 20.
+  const ImageRgba all = renderer_->renderColor(gpu, cam, fb);
+  EXPECT_TRUE(lit(all, 80 - 20));
+  EXPECT_TRUE(lit(all, 80 + 20));
+  DrawOptions only_right;
+  only_right.point_clouds = {true, false, true};
+  const ImageRgba right = renderer_->renderColor(gpu, cam, fb, only_right);
+  EXPECT_FALSE(lit(right, 80 - 20));
+  EXPECT_TRUE(lit(right, 80 + 20));
+}
+
 Scene goldenScene() {
   Scene s;
   s.background = Color(1, 1, 1, 1);
