@@ -15,6 +15,7 @@
 #include "odometry/error.hpp"
 #include "render/framebuffer.hpp"
 #include "render/renderer.hpp"
+#include "viz/image_bgr.hpp"
 #include "viz/run_views.hpp"
 
 namespace gvio::cli {
@@ -70,13 +71,6 @@ void logSceneSize(const render::Scene& scene) {
   for (const auto& v : scene.voxel_sets) {
     spdlog::debug("scene: {} voxels of {:g} m", v.centers.size(), v.size_m);
   }
-}
-
-cv::Mat toBgr(const render::ImageRgba& image) {
-  cv::Mat rgba(image.height, image.width, CV_8UC4, const_cast<std::uint8_t*>(image.rgba.data())),
-      bgr;
-  cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
-  return bgr;
 }
 
 int runVideo(const RenderCliOptions& o, ProgressStyle progress) {
@@ -135,7 +129,7 @@ int runRender(const RenderCliOptions& o, ProgressStyle progress) {
   render::ImageRgba image = renderer.renderColor(gpu, spec.camera, target);
   const double draw_ms = clock.lapMs();
   render::annotate(image, spec.annotations);
-  io::writePng(o.out, toBgr(image));
+  io::writePng(o.out, viz::toBgr(image));
   spdlog::info(
       "wrote {} ({}x{}, view {}): read {:.0f} ms, scene {:.0f} ms, upload {:.0f} ms, "
       "draw {:.0f} ms",

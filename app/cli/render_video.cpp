@@ -18,6 +18,7 @@
 #include "render/framebuffer.hpp"
 #include "render/renderer.hpp"
 #include "viz/camera_view.hpp"
+#include "viz/image_bgr.hpp"
 #include "viz/map_layers.hpp"
 #include "viz/run_views.hpp"
 #include "viz/video_views.hpp"
@@ -32,13 +33,6 @@ constexpr double kRevealM = 40.0;
 constexpr double kTileM = 32.0;
 constexpr double kDrawRadiusM = 120.0;
 constexpr double kTrailS = 20.0;  // the follow video's path: the last 20 s
-
-cv::Mat toBgr(const render::ImageRgba& image) {
-  cv::Mat rgba(image.height, image.width, CV_8UC4, const_cast<std::uint8_t*>(image.rgba.data())),
-      bgr;
-  cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
-  return bgr;
-}
 
 // The container's codec by extension (FFmpeg picks the container from it).
 std::vector<int> codecsFor(const fs::path& out) {
@@ -126,7 +120,7 @@ int followVideo(const VideoRequest& r, const io::RunFiles& run) {
     const Eigen::Isometry3d T_w_b = viz::poseAt(traj, t_ns);
     const render::RenderCamera camera = viz::chaseCamera(T_w_b, r.width, r.height);
     draw.point_clouds = viz::tilesInView(centres, camera, kDrawRadiusM, kTileM);
-    cv::Mat bgr = toBgr(renderer.renderColor(gpu, camera, target, draw));
+    cv::Mat bgr = viz::toBgr(renderer.renderColor(gpu, camera, target, draw));
     // The recent trail only: the line is drawn over the image, not depth-tested, and the drive's
     // far earlier parts would cross buildings in front of them.
     viz::drawDrive(bgr, camera, viz::pathUntil(traj, t_ns, kTrailS));
@@ -150,7 +144,7 @@ int topDownVideo(const VideoRequest& r, const io::RunFiles& run) {
     const auto path = viz::pathUntil(traj, t_ns);
     render::ImageRgba image = viz::revealedAlongPath(full, spec.camera, path, kRevealM);
     render::annotate(image, spec.annotations);
-    cv::Mat bgr = toBgr(image);
+    cv::Mat bgr = viz::toBgr(image);
     viz::drawDrive(bgr, spec.camera, path);
     viz::drawDriveTime(bgr, driveTimeS(traj, t_ns));
     return bgr;
