@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <regex>
 
@@ -32,6 +33,7 @@ struct RenderCliOptions {
   // --video
   std::optional<std::string> video;
   double fps = 10.0, speed = 1.0;
+  double from_s = 0.0, to_s = INFINITY;
   bool size_given = false;
 };
 
@@ -82,6 +84,7 @@ int runVideo(const RenderCliOptions& o, ProgressStyle progress) {
   std::tie(r.width, r.height) = parseSize(o.size_given ? o.size : "1280x720");
   r.fps = o.fps;
   r.speed = o.speed;
+  r.span = {o.from_s, o.to_s};
   if (o.dataset) r.dataset = *o.dataset;
   r.overlay = o.overlay;
   r.map_colour = o.map_colour;
@@ -172,6 +175,8 @@ Command addRenderCommand(CLI::App& app, const CommonOptions& common) {
   sub->add_option("--fps", o->fps, "--video: frames per second of video (default 10)");
   sub->add_option("--speed", o->speed,
                   "--video: seconds of drive per second of video (default 1: real time)");
+  sub->add_option("--from", o->from_s, "--video: start, seconds into the drive (default 0)");
+  sub->add_option("--to", o->to_s, "--video: end, seconds into the drive (default: its end)");
   sub->add_option("--out", o->out, "Output PNG");
   return {sub, [o, &common] { return runRender(*o, common.progressStyle()); }};
 }

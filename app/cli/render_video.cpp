@@ -88,7 +88,7 @@ double driveTimeS(const Trajectory& traj, std::int64_t t_ns) {
 // once, in ground tiles, and each frame draws the tiles near and ahead of the camera.
 int followVideo(const VideoRequest& r, const io::RunFiles& run) {
   const Trajectory& traj = viz::mapTrajectory(run);
-  const auto times = viz::videoFrameTimes(traj, r.fps, r.speed);
+  const auto times = viz::videoFrameTimes(traj, r.fps, r.speed, r.span);
   render::Scene scene;
   std::vector<Eigen::Vector3d> centres;
   if (run.cloud && !run.cloud->p_enu.empty()) {
@@ -133,7 +133,7 @@ int followVideo(const VideoRequest& r, const io::RunFiles& run) {
 // The top-down map revealed along the path driven so far.
 int topDownVideo(const VideoRequest& r, const io::RunFiles& run) {
   const Trajectory& traj = viz::mapTrajectory(run);
-  const auto times = viz::videoFrameTimes(traj, r.fps, r.speed);
+  const auto times = viz::videoFrameTimes(traj, r.fps, r.speed, r.span);
   const viz::ViewSpec spec = viz::buildTopDownMapOnly(run, r.width, r.height);
   const render::EglContext context;
   const render::Renderer renderer(context);
@@ -158,7 +158,7 @@ int cameraVideo(const VideoRequest& r) {
   options.colour = viz::parseMapColour(r.map_colour);
   const RecordedCameraOverlay overlay(r.run, r.dataset, options, viz::parseOverlayMode(r.overlay));
   const Trajectory& traj = viz::mapTrajectory(overlay.run());
-  const auto times = viz::videoFrameTimes(traj, r.fps, r.speed);
+  const auto times = viz::videoFrameTimes(traj, r.fps, r.speed, r.span);
   encode(r, times, overlay.width(), overlay.height(), [&](std::int64_t t_ns) {
     cv::Mat bgr = overlay.at(t_ns);
     viz::drawDriveTime(bgr, driveTimeS(traj, t_ns));

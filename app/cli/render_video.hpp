@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cli/progress.hpp"
+#include "viz/video_views.hpp"
 
 namespace gvio::cli {
 
@@ -16,6 +17,7 @@ struct VideoRequest {
   int width = 1280, height = 720;  // follow and topdown; camera videos have the camera's size
   double fps = 10.0;               // frames per second of video
   double speed = 1.0;              // seconds of drive per second of video
+  viz::DriveSpan span;             // --from / --to
   // --view camera
   std::optional<std::filesystem::path> dataset;
   std::string overlay = "blend", map_colour = "depth";

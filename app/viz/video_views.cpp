@@ -28,14 +28,23 @@ VideoView parseVideoView(const std::string& name) {
   throw InvalidInput("unknown video view '" + name + "' (expected follow, topdown or camera)");
 }
 
-std::vector<std::int64_t> videoFrameTimes(const Trajectory& traj, double fps, double speed) {
+std::vector<std::int64_t> videoFrameTimes(const Trajectory& traj, double fps, double speed,
+                                          const DriveSpan& span) {
   if (!(fps > 0.0) || !std::isfinite(fps)) throw InvalidInput("--fps must be > 0");
   if (!(speed > 0.0) || !std::isfinite(speed)) throw InvalidInput("--speed must be > 0");
   if (!traj.hasTimestamps() || traj.empty()) {
     throw InvalidInput("the trajectory has no timestamps to make a video along");
   }
+  const double length_s = static_cast<double>(traj.t_ns.back() - traj.t_ns.front()) * 1e-9;
+  if (!(span.from_s >= 0.0) || !(span.to_s > span.from_s) || span.from_s > length_s) {
+    throw InvalidInput(fmt::format("--from {:g} --to {:g}: not a span of the {:.1f} s drive",
+                                   span.from_s, span.to_s, length_s));
+  }
   const double step_s = speed / fps;
-  const std::int64_t t0 = traj.t_ns.front(), t1 = traj.t_ns.back();
+  const std::int64_t t0 = traj.t_ns.front() + static_cast<std::int64_t>(span.from_s * 1e9);
+  const std::int64_t t1 = span.to_s >= length_s
+                              ? traj.t_ns.back()
+                              : traj.t_ns.front() + static_cast<std::int64_t>(span.to_s * 1e9);
   std::vector<std::int64_t> times;
   for (std::int64_t k = 0;; ++k) {
     const auto t =

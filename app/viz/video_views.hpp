@@ -23,10 +23,18 @@ namespace gvio::viz {
 enum class VideoView { kFollow, kTopDown, kCamera };
 VideoView parseVideoView(const std::string& name);  // InvalidInput for anything else
 
-// The instants of the video's frames: from the trajectory's first stamp to its last, one every
-// speed / fps seconds of the drive (the video then plays `speed` times faster than the drive).
-// InvalidInput for fps or speed not > 0 or a trajectory without stamps.
-std::vector<std::int64_t> videoFrameTimes(const Trajectory& traj, double fps, double speed);
+// The part of the drive a video shows, in seconds from the trajectory's first stamp.
+struct DriveSpan {
+  double from_s = 0.0;
+  double to_s = INFINITY;  // the end of the trajectory
+};
+
+// The instants of the video's frames: from the span's start to its end (clamped to the
+// trajectory), one every speed / fps seconds of the drive (the video then plays `speed` times
+// faster than the drive). InvalidInput for fps or speed not > 0, a trajectory without stamps, or
+// a span that is empty or outside the trajectory.
+std::vector<std::int64_t> videoFrameTimes(const Trajectory& traj, double fps, double speed,
+                                          const DriveSpan& span = {});
 
 // A chase camera: 14 m behind the body along its heading (the body x axis on the ground plane),
 // 7 m above it, looking at a point 10 m ahead; 60 degrees vertical field of view.

@@ -44,6 +44,15 @@ TEST(VideoFrameTimes, OneFramePerStepFromTheFirstStampToTheLast) {
   EXPECT_THROW((void)videoFrameTimes(t, 0.0, 1.0), InvalidInput);
   EXPECT_THROW((void)videoFrameTimes(t, 10.0, -1.0), InvalidInput);
   EXPECT_THROW((void)videoFrameTimes(Trajectory{}, 10.0, 1.0), InvalidInput);
+  // A span: 2 s to 4 s, both ends included; a span past the end is clamped to it.
+  const auto span = videoFrameTimes(t, 10.0, 1.0, {2.0, 4.0});
+  ASSERT_EQ(span.size(), 21U);
+  EXPECT_EQ(span.front(), t.t_ns[20]);
+  EXPECT_EQ(span.back(), t.t_ns[40]);
+  EXPECT_EQ(videoFrameTimes(t, 10.0, 1.0, {9.0, 60.0}).back(), t.t_ns.back());
+  EXPECT_THROW((void)videoFrameTimes(t, 10.0, 1.0, {4.0, 2.0}), InvalidInput);
+  EXPECT_THROW((void)videoFrameTimes(t, 10.0, 1.0, {11.0, 20.0}), InvalidInput);
+  EXPECT_THROW((void)videoFrameTimes(t, 10.0, 1.0, {-1.0, 2.0}), InvalidInput);
 }
 
 TEST(VideoViews, ChaseCameraLooksAlongTheHeadingFromBehind) {
