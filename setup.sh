@@ -140,10 +140,12 @@ case "$mode" in
     "$BUILD_DIR/app/gvio" run --dataset out/demo/drive --gnss graph --out out/demo/run \
       --set fusion.origin=48.98253,8.39035,116.4 --set "fusion.lever_arm_b=[0,0,0.8]"
     # The views shown in README.md (docs/images/ holds copies): trajectory error, and the map from
-    # above, in perspective and as OctoMap voxels.
+    # above, in perspective, as OctoMap voxels and over a camera image.
     for view in error topdown perspective octomap; do
       "$BUILD_DIR/app/gvio" render --run out/demo/run --view "$view" --out "out/demo/run/render/$view.png"
     done
+    # The map over the recorded left camera 12 s into the drive.
+    "$BUILD_DIR/app/gvio" render --run out/demo/run --view camera --at 12 --out out/demo/run/render/camera.png
     echo "setup: demo drive in out/demo/drive, run (trajectories, map.pcd/ply/las/bt/ot, report.json)" \
       "in out/demo/run, images in out/demo/run/render"
     ;;

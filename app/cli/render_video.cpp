@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <functional>
+#include <optional>
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -11,6 +13,7 @@
 #include "cli/render_camera.hpp"
 #include "io/atomic_write.hpp"
 #include "io/input_error.hpp"
+#include "io/quiet_stderr.hpp"
 #include "io/run_dir.hpp"
 #include "odometry/error.hpp"
 #include "render/annotate.hpp"
@@ -74,8 +77,20 @@ void encode(const VideoRequest& r, const std::vector<std::int64_t>& times, int w
     }
     progress.finish();
     writer.release();
-    if (!fs::exists(tmp) || fs::file_size(tmp) == 0) {
-      throw io::InputError(r.out, 0, "the video encoder wrote nothing");
+    // VideoWriter reports no write errors (a full disk, a file size limit): read the container's
+    // frame count back (its index, no decoding) before the file replaces anything.
+    std::optional<cv::VideoCapture> check;
+    {
+      const io::QuietStderr quiet;  // FFmpeg logs "moov atom not found" for a cut-short file
+      check.emplace(tmp.string(), cv::CAP_FFMPEG);
+    }
+    const auto written = static_cast<std::size_t>(
+        std::llround(check->isOpened() ? check->get(cv::CAP_PROP_FRAME_COUNT) : -1.0));
+    if (!check->isOpened() || written != times.size()) {
+      throw io::InputError(r.out, 0,
+                           fmt::format("the video was not written completely ({} of {} frames "
+                                       "readable: disk full or a file size limit?)",
+                                       check->isOpened() ? written : 0, times.size()));
     }
   });
 }

@@ -236,6 +236,15 @@ TEST_F(CliRenderCamera, BadVideoRequestsExitTwo) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr("expected follow, topdown or camera"));
   EXPECT_FALSE(fs::exists(out("v.mp4")));
+  // A file size limit (ulimit -f counts 1024-byte blocks) cuts the video short: refused, and
+  // neither it nor its temporary is left.
+  r = runGvioWithEnv("ulimit -f 20;", base + " --size 320x240 --video " + out("v.mp4"));
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("not written completely"));
+  EXPECT_FALSE(fs::exists(out("v.mp4")));
+  for (const auto& e : fs::directory_iterator(dir_->path())) {
+    EXPECT_EQ(e.path().filename().string().find("gvio-tmp"), std::string::npos) << e.path();
+  }
 }
 
 }  // namespace
