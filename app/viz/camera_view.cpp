@@ -23,14 +23,18 @@ const cv::Scalar kPathBgr(191, 25, 242);  // kPathColor
 
 }  // namespace
 
-std::vector<Eigen::Vector3d> pathAhead(const io::RunFiles& run, std::int64_t t_ns, double ahead_s) {
-  const Trajectory& traj = mapTrajectory(run);
+std::vector<Eigen::Vector3d> positionsBetween(const Trajectory& traj, std::int64_t t0_ns,
+                                              std::int64_t t1_ns) {
   std::vector<Eigen::Vector3d> path;
-  const auto end_ns = t_ns + static_cast<std::int64_t>(ahead_s * 1e9);
-  for (std::size_t i = 0; i < traj.size() && traj.hasTimestamps(); ++i) {
-    if (traj.t_ns[i] >= t_ns && traj.t_ns[i] <= end_ns) path.push_back(traj.poses[i].translation());
+  for (std::size_t i = 0; i < traj.size() && i < traj.t_ns.size(); ++i) {
+    if (traj.t_ns[i] >= t0_ns && traj.t_ns[i] <= t1_ns) path.push_back(traj.poses[i].translation());
   }
   return path;
+}
+
+std::vector<Eigen::Vector3d> pathAhead(const io::RunFiles& run, std::int64_t t_ns, double ahead_s) {
+  return positionsBetween(mapTrajectory(run), t_ns,
+                          t_ns + static_cast<std::int64_t>(ahead_s * 1e9));
 }
 
 void drawPath(cv::Mat& bgr, const render::RenderCamera& camera,

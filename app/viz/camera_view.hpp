@@ -52,6 +52,10 @@ struct CameraViewOptions {
 render::Scene cameraScene(const io::RunFiles& run, const render::RenderCamera& camera,
                           std::int64_t t_ns, const CameraViewOptions& options);
 
+// The trajectory's positions with stamps in [t0_ns, t1_ns].
+std::vector<Eigen::Vector3d> positionsBetween(const Trajectory& traj, std::int64_t t0_ns,
+                                              std::int64_t t1_ns);
+
 // The map trajectory's positions from t_ns to t_ns + ahead_s.
 std::vector<Eigen::Vector3d> pathAhead(const io::RunFiles& run, std::int64_t t_ns, double ahead_s);
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <utility>
 
@@ -104,13 +105,10 @@ std::vector<bool> tilesInView(const std::vector<Eigen::Vector3d>& centres,
 }
 
 std::vector<Eigen::Vector3d> pathUntil(const Trajectory& traj, std::int64_t t_ns, double window_s) {
-  std::vector<Eigen::Vector3d> path;
-  for (std::size_t i = 0; i < traj.size() && i < traj.t_ns.size() && traj.t_ns[i] <= t_ns; ++i) {
-    if (static_cast<double>(t_ns - traj.t_ns[i]) * 1e-9 <= window_s) {
-      path.push_back(traj.poses[i].translation());
-    }
-  }
-  return path;
+  const std::int64_t t0_ns = std::isfinite(window_s)
+                                 ? t_ns - static_cast<std::int64_t>(window_s * 1e9)
+                                 : std::numeric_limits<std::int64_t>::min();
+  return positionsBetween(traj, t0_ns, t_ns);
 }
 
 render::ImageRgba revealedAlongPath(const render::ImageRgba& full,
