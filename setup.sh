@@ -29,6 +29,8 @@ PACKAGES=(
 # Only the modes that build the test suite need its frameworks.
 TEST_PACKAGES=(libgtest-dev libgmock-dev libbenchmark-dev)
 [ "$mode" != demo ] && PACKAGES+=("${TEST_PACKAGES[@]}")
+# The fleet's Slurm test starts a single-node cluster (tests/fleet/slurm_fleet_test.sh).
+[ "$mode" = test ] && PACKAGES+=(slurm-wlm munge)
 # Sanitizers and libFuzzer come with clang.
 SANITIZER_PACKAGES=(clang-14 libfuzzer-14-dev libclang-rt-14-dev)
 case "$mode" in sanitize | fuzz) PACKAGES+=("${SANITIZER_PACKAGES[@]}") ;; esac

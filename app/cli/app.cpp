@@ -110,6 +110,9 @@ int runMain(int argc, char** argv) {
   commands.push_back(addRunCommand(app, common));
   commands.push_back(addExportCommand(app));
   commands.push_back(addConsistencyCommand(app));
+  commands.push_back(addFleetCommand(app));
+  commands.push_back(addFleetTaskCommand(app));
+  commands.push_back(addMergeCommand(app));
 
   try {
     app.parse(argc, argv);

@@ -43,6 +43,9 @@ Command addSimulateCommand(CLI::App& app, const CommonOptions& common);
 Command addRunCommand(CLI::App& app, const CommonOptions& common);
 Command addExportCommand(CLI::App& app);
 Command addConsistencyCommand(CLI::App& app);
+Command addFleetCommand(CLI::App& app);
+Command addFleetTaskCommand(CLI::App& app);
+Command addMergeCommand(CLI::App& app);
 
 int runMain(int argc, char** argv);
 

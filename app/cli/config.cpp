@@ -375,6 +375,16 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("sim.imu_noise_scale_max", c.sim.imu_noise_scale_max),
       number("sim.imu_turn_on_acc_bias_mps2", c.sim.imu_turn_on_acc_bias_mps2),
       number("sim.imu_turn_on_gyr_bias_radps", c.sim.imu_turn_on_gyr_bias_radps),
+      integer("fleet.retries", c.fleet.retries),
+      integer("fleet.slurm.cpus_per_task", c.fleet.slurm.cpus_per_task),
+      integer("fleet.slurm.mem_mb", c.fleet.slurm.mem_mb),
+      integer("fleet.slurm.time_limit_min", c.fleet.slurm.time_limit_min),
+      text("fleet.slurm.partition", c.fleet.slurm.partition),
+      text("fleet.slurm.account", c.fleet.slurm.account),
+      text("fleet.slurm.job_name", c.fleet.slurm.job_name),
+      number("merge.tile_size_m", c.merge.tile_size_m),
+      number("merge.octomap_resolution_m", c.merge.octomap_resolution_m),
+      number("merge.max_zone_distance_km", c.merge.max_zone_distance_km),
   };
 }
 

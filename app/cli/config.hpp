@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fleet/fleet_config.hpp"
 #include "run/run_config.hpp"
 #include "sim/gnss_error.hpp"
 #include "sim/sim_config.hpp"
@@ -19,9 +20,12 @@ using run::ImuConfig;
 using run::MapAppConfig;
 using run::VioConfig;
 
-// Every section of the configuration: gvio run's (run::RunConfig) and the simulator's.
+// Every section of the configuration: gvio run's (run::RunConfig), the simulator's, the fleet's
+// and the merge's.
 struct AppConfig : run::RunConfig {
   sim::SimConfig sim;
+  fleet::FleetConfig fleet;
+  fleet::MergeConfig merge;
 
   void validate() const;  // throws InvalidInput naming the key
 };

@@ -25,12 +25,13 @@ extern "C" void onInterrupt(int signal) {
 
 }  // namespace
 
-InterruptGuard::InterruptGuard() {
+InterruptGuard::InterruptGuard(bool restart_calls) {
   g_signal = 0;
   struct sigaction action {};
   action.sa_handler = onInterrupt;
   sigemptyset(&action.sa_mask);
-  action.sa_flags = SA_RESETHAND | SA_RESTART;  // restart reads and writes the signal interrupted
+  // Restart reads and writes the signal interrupted (unless the caller waits for it).
+  action.sa_flags = SA_RESETHAND | (restart_calls ? SA_RESTART : 0);
   sigaction(SIGINT, &action, &previous_int_);
   sigaction(SIGTERM, &action, &previous_term_);
 }

@@ -10,7 +10,9 @@ namespace gvio::cli {
 
 class InterruptGuard {
  public:
-  InterruptGuard();   // installs the handlers
+  // Installs the handlers. With `restart_calls` false, a blocking call the signal interrupts
+  // (waitpid of a fleet's children) returns EINTR instead of resuming, so its caller sees it.
+  explicit InterruptGuard(bool restart_calls = true);
   ~InterruptGuard();  // restores the previous ones
   InterruptGuard(const InterruptGuard&) = delete;
   InterruptGuard& operator=(const InterruptGuard&) = delete;

@@ -19,8 +19,17 @@ namespace gvio::exporter {
 
 struct LasPoint {
   Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();
-  std::uint16_t intensity = 0;      // normalised to the full 16-bit range (LAS 1.4, "Intensity")
-  std::uint8_t classification = 0;  // ASPRS class; 0 = created, never classified
+  std::uint16_t intensity = 0;        // normalised to the full 16-bit range (LAS 1.4, "Intensity")
+  std::uint8_t classification = 0;    // ASPRS class; 0 = created, never classified
+  std::uint16_t point_source_id = 0;  // the flight line (for gvio: the drive), 0 = none
+};
+
+// A point already in the file's UTM zone: easting, northing, ellipsoidal height.
+struct LasUtmPoint {
+  Eigen::Vector3d p_utm = Eigen::Vector3d::Zero();
+  std::uint16_t intensity = 0;
+  std::uint8_t classification = 0;
+  std::uint16_t point_source_id = 0;
 };
 
 struct LasOptions {
@@ -43,6 +52,14 @@ Eigen::Vector3d enuToUtm(const fusion::EnuFrame& enu, const Eigen::Vector3d& p_e
 // Point k (0 <= k < n) of a cloud, or nullopt for one the file leaves out: lets a large cloud be
 // written without a copy of it (KITTI-00's 14 M-point map). Called twice per point.
 using LasPointAt = std::function<std::optional<LasPoint>(std::size_t k)>;
+
+// Point k of a cloud already in UTM, or nullopt for one left out; called twice per point.
+using LasUtmPointAt = std::function<std::optional<LasUtmPoint>(std::size_t k)>;
+
+// Writes points already in UTM zone `crs.zone` (hemisphere `crs.north`) to `file` atomically,
+// streaming in two passes (bounds, then records). Throws as writeLas below.
+LasSummary writeLasUtm(const std::filesystem::path& file, const fusion::Utm& crs, std::size_t n,
+                       const LasUtmPointAt& point_at, double scale_m = 0.001);
 
 // Writes the points (local ENU at `enu_origin`) to `file` atomically, streaming: a first pass
 // finds the bounds (header, offsets), the second writes the records, so nothing per point is

@@ -140,6 +140,7 @@ void writeSimYaml(const fs::path& file, const SimRequest& r, const SimSummary& s
   YAML::Emitter y;
   y << YAML::BeginMap << YAML::Key << "generator" << YAML::Value << "gvio simulate";
   y << YAML::Key << "seed" << YAML::Value << r.seed;
+  y << YAML::Key << "world_seed" << YAML::Value << r.world_seed.value_or(r.seed);
   y << YAML::Key << "trajectory" << YAML::Value << r.trajectory.filename().string();
   y << YAML::Key << "orientation" << YAML::Value << toString(r.orientation);
   y << YAML::Key << "format" << YAML::Value << io::toString(r.output);
@@ -235,7 +236,7 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
   // World along the route.
   const std::vector<Eigen::Vector3d> route = routeOf(traj, t1, summary.path_length_m);
   WorldOptions world_opt;
-  world_opt.seed = mixSeed(r.seed, 3);
+  world_opt.seed = r.world_seed ? mixSeed(*r.world_seed, 3) : mixSeed(r.seed, 3);
   world_opt.style = *parseWorldStyle(config.world_style);  // validated
   world_opt.texture_size_px = config.texture_size_px;
   const World world = buildWorld(route, world_opt);

@@ -30,6 +30,9 @@ struct SimRequest {
   GnssNoise gnss = GnssNoise::kSpp;
   std::vector<std::pair<double, double>> outages_s;  // seconds since the drive's start
   std::uint64_t seed = 1;
+  // The street world's seed (buildings, furniture, textures); nullopt: derived from `seed`. Two
+  // drives of one route with one world seed see the same streets (a fleet).
+  std::optional<std::uint64_t> world_seed;
   std::filesystem::path out;
   bool force = false;
   std::string config_yaml;  // the effective configuration, recorded in sim.yaml

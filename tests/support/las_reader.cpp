@@ -109,6 +109,7 @@ void readPoints(const Cursor& c, LasFile& las) {
     r.return_number = returns & 0x0F;
     r.number_of_returns = returns >> 4;
     r.classification = c.at<std::uint8_t>(p + 16);
+    r.point_source_id = c.at<std::uint16_t>(p + 20);  // after user data (17) and scan angle (18)
     r.gps_time = c.at<double>(p + 22);
     if (las.point_format == 7) {
       r.rgb = std::array<std::uint16_t, 3>{c.at<std::uint16_t>(p + 30), c.at<std::uint16_t>(p + 32),

@@ -26,6 +26,7 @@ struct LasRecord {
   std::uint16_t intensity = 0;
   int return_number = 0, number_of_returns = 0;
   std::uint8_t classification = 0;
+  std::uint16_t point_source_id = 0;
   double gps_time = 0.0;
   std::optional<std::array<std::uint16_t, 3>> rgb;  // format 7
 };

@@ -38,6 +38,7 @@ std::vector<LasPoint> randomPoints(int n, double extent_m, unsigned seed) {
     p.p_enu = {xy(rng), xy(rng), z(rng)};
     p.intensity = static_cast<std::uint16_t>(rng() % 65536);
     p.classification = static_cast<std::uint8_t>(rng() % 20);
+    p.point_source_id = static_cast<std::uint16_t>(rng() % 65536);
     points.push_back(p);
   }
   return points;
@@ -81,6 +82,7 @@ TEST(ExportLas, HeaderVlrAndPointsReadBackAsWritten) {
     worst_m = std::max(worst_m, (las.points[i].xyz - expected).cwiseAbs().maxCoeff());
     EXPECT_EQ(las.points[i].intensity, points[i].intensity);
     EXPECT_EQ(las.points[i].classification, points[i].classification);
+    EXPECT_EQ(las.points[i].point_source_id, points[i].point_source_id);
     EXPECT_EQ(las.points[i].return_number, 1);
     EXPECT_EQ(las.points[i].number_of_returns, 1);
     lo = lo.cwiseMin(las.points[i].xyz);

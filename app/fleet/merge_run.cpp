@@ -1,0 +1,110 @@
+#include "fleet/merge_run.hpp"
+
+#include <unistd.h>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <set>
+
+#include "fusion/enu_utm_grid.hpp"
+#include "io/input_error.hpp"
+#include "io/run_dir.hpp"
+#include "run/stats.hpp"
+
+namespace gvio::fleet {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A run's map.pcd into the spill, in the merge's UTM zone.
+std::uint64_t spillRun(const MergeRun& run, const MergeFrame& frame, TileSpill& spill) {
+  const io::MapCloud cloud = io::readMapCloud(run.dir / "map.pcd");
+  fusion::EnuToUtmGrid grid(run.georef.enu_origin, frame.crs.zone, frame.crs.north);
+  std::uint64_t added = 0;
+  for (std::size_t k = 0; k < cloud.p_enu.size(); ++k) {
+    const Eigen::Vector3d p_enu = cloud.p_enu[k].cast<double>();
+    if (!p_enu.allFinite()) continue;
+    const float intensity = cloud.intensity.empty() ? 0.0F : cloud.intensity[k];
+    const auto las_intensity =
+        static_cast<std::uint16_t>(std::clamp(intensity, 0.0F, 255.0F) * 257.0F);
+    const std::uint8_t source = cloud.source.empty() ? io::MapCloud::kSparse : cloud.source[k];
+    spill.add(grid.toUtm(p_enu), las_intensity, run.point_source_id, source);
+    ++added;
+  }
+  return added;
+}
+
+// Tiles of an earlier merge into this folder that this one did not write.
+void removeStaleTiles(const fs::path& tiles_dir, const std::set<std::string>& written) {
+  for (const auto& entry : fs::directory_iterator(tiles_dir)) {
+    const fs::path p = entry.path();
+    const std::string ext = p.extension().string();
+    const bool tile_file = ext == ".las" || ext == ".pcd" || ext == ".bt";
+    if (tile_file && p.stem().string().starts_with("E") && !written.count(p.stem().string())) {
+      fs::remove(p);
+    }
+  }
+}
+
+}  // namespace
+
+MergeSummary runMerge(const MergeRequest& request) {
+  const auto start = std::chrono::steady_clock::now();
+  request.config.validate();
+  const std::vector<MergeRun> runs = resolveMergeRuns(request.runs);
+  const MergeFrame frame = chooseMergeFrame(runs, request.config);
+  const fs::path tiles_dir = request.out_dir / "tiles";
+  std::error_code ec;
+  fs::create_directories(tiles_dir, ec);
+  if (ec) throw io::InputError(request.out_dir, 0, "cannot create the folder: " + ec.message());
+
+  MergeSummary summary;
+  summary.tile_size_m = request.config.tile_size_m;
+  TileSpill spill(request.out_dir / fmt::format(".merge-scratch-{}", ::getpid()),
+                  request.config.tile_size_m, frame.origin_utm.z());
+  for (const MergeRun& run : runs) {
+    const std::uint64_t n = spillRun(run, frame, spill);
+    summary.points_per_drive[run.point_source_id] = n;
+    summary.points += n;
+    spdlog::info("merge: {} ({} points, point source ID {})", run.name, n, run.point_source_id);
+  }
+  spill.flushAll();
+  const auto spilled = std::chrono::steady_clock::now();
+  spdlog::debug("merge: first pass (read, convert, spill) {:.2f} s",
+                std::chrono::duration<double>(spilled - start).count());
+  std::set<std::string> written;
+  for (const auto& [key, count] : spill.counts()) {
+    summary.tiles.push_back(
+        writeTile(request.out_dir, frame, spill, key, request.config, summary.agreement));
+    written.insert(summary.tiles.back().name);
+  }
+  removeStaleTiles(tiles_dir, written);
+  spdlog::debug("merge: second pass (tiles) {:.2f} s",
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - spilled).count());
+  summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.points_per_s =
+      summary.wall_s > 0.0 ? static_cast<double>(summary.points) / summary.wall_s : 0.0;
+  summary.peak_rss_mb = run::peakRssMb();
+  writeMergeIndex(request.out_dir, runs, frame, summary);
+  spdlog::info(
+      "merge: {} points of {} run(s) in {} tile(s) of {} m, UTM zone {}{} (EPSG:{}); "
+      "{:.1f} s, {:.2f} M points/s; {}",
+      summary.points, runs.size(), summary.tiles.size(), summary.tile_size_m, frame.crs.zone,
+      frame.crs.north ? "N" : "S", frame.crs.epsg(), summary.wall_s, summary.points_per_s / 1e6,
+      (request.out_dir / "tiles.json").string());
+  for (const MergeRun& run : runs) {
+    const auto it = summary.agreement.find(run.point_source_id);
+    if (it == summary.agreement.end() || it->second.overlap == 0) continue;
+    const DriveAgreement& a = it->second;
+    spdlog::info(
+        "merge: {}: {:.1f} % of {} overlapping dense points (a 1-in-{} sample) within {} m of an "
+        "earlier drive's (median {:.3f} m)",
+        run.name, 100.0 * static_cast<double>(a.within) / static_cast<double>(a.overlap), a.overlap,
+        DriveAgreement::kQueryStride, DriveAgreement::kWithinM, a.medianM());
+  }
+  return summary;
+}
+
+}  // namespace gvio::fleet

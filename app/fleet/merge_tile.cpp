@@ -1,0 +1,269 @@
+#include "fleet/merge_tile.hpp"
+
+#include <octomap/OcTree.h>
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_types.h>
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <unordered_set>
+
+#include "export/las_writer.hpp"
+#include "io/atomic_write.hpp"
+#include "io/input_error.hpp"
+#include "io/quiet_stderr.hpp"
+#include "io/run_dir.hpp"
+
+namespace gvio::fleet {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The point's offsets from its tile's south-west corner and the spill's height origin.
+Eigen::Vector3d offsets(const SpillPoint& p) {
+  return Eigen::Vector3f(p.x, p.y, p.z).cast<double>();
+}
+
+// UTM easting, northing and ellipsoidal height.
+Eigen::Vector3d utmOf(const TileSpill& spill, const TileKey& key, const SpillPoint& p) {
+  const Eigen::Vector2d sw = spill.southWest(key);
+  return Eigen::Vector3d(sw.x(), sw.y(), spill.originHeight()) + offsets(p);
+}
+
+// The map frame: UTM less the map origin's.
+Eigen::Vector3d mapFrame(const MergeFrame& frame, const TileSpill& spill, const TileKey& key,
+                         const SpillPoint& p) {
+  const Eigen::Vector2d sw = spill.southWest(key);
+  return Eigen::Vector3d(sw.x() - frame.origin_utm.x(), sw.y() - frame.origin_utm.y(),
+                         spill.originHeight() - frame.origin_utm.z()) +
+         offsets(p);
+}
+
+void writeTilePcd(const fs::path& file, const MergeFrame& frame, const TileSpill& spill,
+                  const TileKey& key, const std::vector<SpillPoint>& points) {
+  pcl::PCLPointCloud2 cloud;
+  const auto field = [](const char* name, std::uint32_t offset, std::uint8_t type) {
+    pcl::PCLPointField f;
+    f.name = name;
+    f.offset = offset;
+    f.datatype = type;
+    f.count = 1;
+    return f;
+  };
+  using F = pcl::PCLPointField;
+  cloud.fields = {field("x", 0, F::FLOAT32),
+                  field("y", 4, F::FLOAT32),
+                  field("z", 8, F::FLOAT32),
+                  field("intensity", 12, F::FLOAT32),
+                  field("point_source_id", 16, F::UINT16),
+                  field("source", 18, F::UINT8)};
+  cloud.point_step = 20;
+  cloud.width = static_cast<std::uint32_t>(points.size());
+  cloud.height = 1;
+  cloud.row_step = cloud.point_step * cloud.width;
+  cloud.is_dense = true;
+  cloud.data.resize(cloud.row_step);
+  std::uint8_t* out = cloud.data.data();
+  for (const SpillPoint& p : points) {
+    const Eigen::Vector3f m = mapFrame(frame, spill, key, p).cast<float>();
+    const float intensity = static_cast<float>(p.intensity) / 257.0F;  // back to 0..255
+    std::memcpy(out, m.data(), 12);
+    std::memcpy(out + 12, &intensity, 4);
+    std::memcpy(out + 16, &p.point_source_id, 2);
+    std::memcpy(out + 18, &p.source, 1);
+    out[19] = 0;
+    out += cloud.point_step;
+  }
+  // Binary, not binary_compressed: a tile is small, and LZF would take a third of the merge.
+  io::writeViaPathAtomic(file, ".pcd", [&](const fs::path& tmp) {
+    if (pcl::PCDWriter().writeBinary(tmp.string(), cloud) != 0) {
+      throw io::InputError(file, 0, "PCL could not write the tile");
+    }
+  });
+}
+
+// Occupied voxels where points fall (no free space: the points carry no sensor origin). Each
+// voxel is updated once however many points it holds (the tile's keys are sorted and made
+// unique first), which is what makes this fast.
+std::size_t writeTileOctomap(const fs::path& file, const MergeFrame& frame, const TileSpill& spill,
+                             const TileKey& key, const std::vector<SpillPoint>& points,
+                             double resolution_m, std::string& note) {
+  octomap::OcTree tree(resolution_m);
+  std::vector<octomap::OcTreeKey> keys;
+  keys.reserve(points.size());
+  for (const SpillPoint& p : points) {
+    const Eigen::Vector3d m = mapFrame(frame, spill, key, p);
+    octomap::OcTreeKey k;
+    if (!tree.coordToKeyChecked(m.x(), m.y(), m.z(), k)) {
+      note = fmt::format("outside OctoMap's key range at {} m ({:.0f} km from the map origin)",
+                         resolution_m, 32768 * resolution_m / 1000.0);
+      return 0;
+    }
+    keys.push_back(k);
+  }
+  // Three 16-bit key parts in one integer: sorting those is several times faster than keys.
+  // Dense stereo points arrive in runs within one voxel: dropping repeats first halves the sort.
+  std::vector<std::uint64_t> packed;
+  packed.reserve(keys.size());
+  for (const auto& k : keys) {
+    const std::uint64_t v = (std::uint64_t{k[0]} << 32) | (std::uint64_t{k[1]} << 16) | k[2];
+    if (packed.empty() || packed.back() != v) packed.push_back(v);
+  }
+  std::sort(packed.begin(), packed.end());
+  packed.erase(std::unique(packed.begin(), packed.end()), packed.end());
+  for (const std::uint64_t v : packed) {
+    const octomap::OcTreeKey k(static_cast<octomap::key_type>(v >> 32),
+                               static_cast<octomap::key_type>(v >> 16),
+                               static_cast<octomap::key_type>(v));
+    tree.updateNode(k, true, /*lazy_eval=*/true);
+  }
+  tree.updateInnerOccupancy();
+  io::writeFileAtomic(file, [&](std::ostream& out) {
+    const io::QuietStderr quiet;  // Debian's OctoMap prints "done." on every write
+    if (!tree.writeBinary(out) && out)
+      throw std::runtime_error("OctoMap could not write " + file.string());
+  });
+  return packed.size();
+}
+
+// The nearest point within `radius` of a query. FLANN's nearest-neighbour search is fast where
+// a neighbour is near and slow where none is (it visits much of the tree), and a radius search
+// visits every point within the radius (hundreds in a dense map): so a hash of the radius-sized
+// cubes that hold points first tells whether any point can be within the radius (one of the 27
+// cubes around the query is occupied), and only then does FLANN look for the nearest.
+class RadiusGrid {
+ public:
+  RadiusGrid(const std::vector<Eigen::Vector3f>& points, double radius_m) : radius_(radius_m) {
+    auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+    cloud->reserve(points.size());
+    for (const auto& p : points) {
+      cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+      occupied_.insert(key(cube(p)));
+    }
+    tree_.setInputCloud(cloud);
+  }
+  [[nodiscard]] std::optional<double> nearest(const Eigen::Vector3f& q) const {
+    if (!anyNear(q)) return std::nullopt;
+    pcl::Indices index(1);
+    std::vector<float> d2(1);
+    if (tree_.nearestKSearch(pcl::PointXYZ(q.x(), q.y(), q.z()), 1, index, d2) < 1) {
+      return std::nullopt;
+    }
+    const double d = std::sqrt(static_cast<double>(d2[0]));
+    if (d > radius_) return std::nullopt;
+    return d;
+  }
+
+ private:
+  [[nodiscard]] bool anyNear(const Eigen::Vector3f& q) const {
+    const Eigen::Vector3i c = cube(q);
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          if (occupied_.count(key(c + Eigen::Vector3i(dx, dy, dz))) != 0) return true;
+        }
+      }
+    }
+    return false;
+  }
+  [[nodiscard]] Eigen::Vector3i cube(const Eigen::Vector3f& p) const {
+    return (p.cast<double>() / radius_).array().floor().cast<int>();
+  }
+  static std::uint64_t key(const Eigen::Vector3i& c) {
+    // 21 bits a coordinate: a tile's cubes lie well within +-2^20 of its corner.
+    const auto part = [](int v) { return static_cast<std::uint64_t>(v + (1 << 20)) & 0x1FFFFF; };
+    return (part(c.x()) << 42) | (part(c.y()) << 21) | part(c.z());
+  }
+
+  double radius_;
+  std::unordered_set<std::uint64_t> occupied_;
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree_;
+};
+
+// Each drive's dense points (away from the border) against the reference drive's: the tile's
+// first (lowest point source ID) drive with dense points. One k-d tree a tile whatever the number
+// of drives; the reference drive itself is not compared.
+void addAgreement(const std::vector<SpillPoint>& points, double tile_size_m,
+                  std::map<std::uint16_t, DriveAgreement>& agreement) {
+  std::map<std::uint16_t, std::vector<Eigen::Vector3f>> dense;
+  for (const SpillPoint& p : points) {
+    if (p.source == io::MapCloud::kDense) dense[p.point_source_id].emplace_back(p.x, p.y, p.z);
+  }
+  if (dense.size() < 2) return;
+  constexpr double r = DriveAgreement::kOverlapRadiusM;
+  const RadiusGrid reference(dense.begin()->second, r);
+  for (auto it = std::next(dense.begin()); it != dense.end(); ++it) {
+    DriveAgreement& a = agreement[it->first];
+    const std::vector<Eigen::Vector3f>& mine = it->second;
+    // A fixed 1-in-kQueryStride sample of the drive's points asks: the percentages of a few
+    // hundred thousand samples are those of all points to well under a percent, at an eighth
+    // of the cost (nearest-neighbour queries are most of a merge's time otherwise).
+    for (std::size_t k = 0; k < mine.size(); k += DriveAgreement::kQueryStride) {
+      const Eigen::Vector3f& m = mine[k];
+      const double x = m.x(), y = m.y();
+      if (x < r || y < r || x > tile_size_m - r || y > tile_size_m - r) continue;
+      ++a.dense_points;
+      if (const auto d = reference.nearest(m)) a.add(*d);
+    }
+  }
+}
+
+}  // namespace
+
+void DriveAgreement::add(double distance_m) {
+  ++overlap;
+  if (distance_m <= kWithinM) ++within;
+  const int bin = std::min(kBins - 1, static_cast<int>(distance_m / kOverlapRadiusM * kBins));
+  ++histogram[static_cast<std::size_t>(std::max(0, bin))];
+}
+
+double DriveAgreement::medianM() const {
+  if (overlap == 0) return 0.0;
+  std::uint64_t seen = 0;
+  for (int b = 0; b < kBins; ++b) {
+    seen += histogram[static_cast<std::size_t>(b)];
+    if (2 * seen >= overlap) return (b + 0.5) * kOverlapRadiusM / kBins;
+  }
+  return kOverlapRadiusM;
+}
+
+std::string tileName(const TileSpill& spill, const TileKey& key) {
+  const Eigen::Vector2d sw = spill.southWest(key);
+  return fmt::format("E{}_N{}", sw.x(), sw.y());
+}
+
+TileResult writeTile(const fs::path& out_dir, const MergeFrame& frame, const TileSpill& spill,
+                     const TileKey& key, const MergeConfig& config,
+                     std::map<std::uint16_t, DriveAgreement>& agreement) {
+  TileResult t;
+  t.key = key;
+  t.name = tileName(spill, key);
+  const std::vector<SpillPoint> points = spill.read(key);
+  t.points = points.size();
+  for (const SpillPoint& p : points) ++t.points_per_drive[p.point_source_id];
+  const fs::path stem = out_dir / "tiles" / t.name;
+  const exporter::LasSummary las = exporter::writeLasUtm(
+      fs::path(stem).concat(".las"), frame.crs, points.size(),
+      [&](std::size_t k) -> std::optional<exporter::LasUtmPoint> {
+        const SpillPoint& p = points[k];
+        return exporter::LasUtmPoint{utmOf(spill, key, p), p.intensity, 0, p.point_source_id};
+      });
+  for (int a = 0; a < 3; ++a) {
+    t.min_utm[static_cast<std::size_t>(a)] = las.min[a];
+    t.max_utm[static_cast<std::size_t>(a)] = las.max[a];
+  }
+  writeTilePcd(fs::path(stem).concat(".pcd"), frame, spill, key, points);
+  t.occupied_voxels = writeTileOctomap(fs::path(stem).concat(".bt"), frame, spill, key, points,
+                                       config.octomap_resolution_m, t.octomap_note);
+  t.octomap = t.octomap_note.empty();
+  addAgreement(points, spill.tileSize(), agreement);
+  return t;
+}
+
+}  // namespace gvio::fleet
