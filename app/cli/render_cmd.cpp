@@ -10,6 +10,7 @@
 #include "cli/app.hpp"
 #include "cli/render_camera.hpp"
 #include "cli/render_video.hpp"
+#include "fleet/merged_map.hpp"
 #include "io/image_loader.hpp"
 #include "io/input_error.hpp"
 #include "io/run_dir.hpp"
@@ -17,10 +18,15 @@
 #include "render/framebuffer.hpp"
 #include "render/renderer.hpp"
 #include "viz/image_bgr.hpp"
+#include "viz/merged_view.hpp"
 #include "viz/run_views.hpp"
 
 namespace gvio::cli {
 namespace {
+
+// Points of a merged map drawn at most (thinned evenly per tile): what a top-down image can show
+// of a city's tiles without reading every point into memory.
+constexpr std::size_t kMergedMapPoints = 8'000'000;
 
 struct RenderCliOptions {
   std::string run, out, view = "topdown", size = "1600x1200";
@@ -75,6 +81,31 @@ void logSceneSize(const render::Scene& scene) {
   }
 }
 
+// Renders a built view into --out (PNG) with its overlays; logs where the time went.
+int drawToPng(viz::ViewSpec& spec, int width, int height, const RenderCliOptions& o, double read_ms,
+              double build_ms) {
+  logSceneSize(spec.scene);
+  Stopwatch clock;
+  const render::EglContext context;
+  spdlog::info("EGL {}: {} ({})", context.info().platform, context.info().gl_renderer,
+               context.info().gl_version);
+  const render::Renderer renderer(context);
+  render::Framebuffer target(width, height);
+  clock.lapMs();
+  const render::GpuScene gpu(spec.scene);
+  spec.scene = {};  // uploaded: the CPU copy of a large map is no longer needed
+  const double upload_ms = clock.lapMs();
+  render::ImageRgba image = renderer.renderColor(gpu, spec.camera, target);
+  const double draw_ms = clock.lapMs();
+  render::annotate(image, spec.annotations);
+  io::writePng(o.out, viz::toBgr(image));
+  spdlog::info(
+      "wrote {} ({}x{}, view {}): read {:.0f} ms, scene {:.0f} ms, upload {:.0f} ms, "
+      "draw {:.0f} ms",
+      o.out, width, height, o.view, read_ms, build_ms, upload_ms, draw_ms);
+  return 0;
+}
+
 int runVideo(const RenderCliOptions& o, ProgressStyle progress) {
   if (o.at_s) throw gvio::InvalidInput("--at is for a still image, not --video");
   VideoRequest r;
@@ -115,29 +146,24 @@ int runRender(const RenderCliOptions& o, ProgressStyle progress) {
   }
   if (const auto warning = io::incompleteRunWarning(o.run)) spdlog::warn("{}", *warning);
   Stopwatch clock;
+  viz::ViewSpec spec;
+  if (fleet::isMergedMap(o.run) && !std::filesystem::exists(o.run + "/trajectory.tum")) {
+    // A `gvio merge` folder: the tiles from above, a colour per drive.
+    if (view != viz::RunView::kTopDown || reference) {
+      throw gvio::InvalidInput("--run " + o.run +
+                               " is a merged map (tiles.json): it draws --view topdown only");
+    }
+    const fleet::MergedMap map = fleet::readMergedMap(o.run, kMergedMapPoints);
+    spdlog::info("merged map: {} of {} points ({} tiles) drawn", map.points.size(),
+                 map.total_points, map.tiles.size());
+    const double read_ms = clock.lapMs();
+    spec = viz::buildMergedTopDown(map, width, height);
+    return drawToPng(spec, width, height, o, read_ms, clock.lapMs());
+  }
   const io::RunFiles run = io::readRunDir(o.run, viz::readOptionsFor(view, reference));
   const double read_ms = clock.lapMs();
-  viz::ViewSpec spec = viz::buildRunView(run, view, width, height);
-  const double build_ms = clock.lapMs();
-  logSceneSize(spec.scene);
-  const render::EglContext context;
-  spdlog::info("EGL {}: {} ({})", context.info().platform, context.info().gl_renderer,
-               context.info().gl_version);
-  const render::Renderer renderer(context);
-  render::Framebuffer target(width, height);
-  clock.lapMs();
-  const render::GpuScene gpu(spec.scene);
-  spec.scene = {};  // uploaded: the CPU copy of a large map is no longer needed
-  const double upload_ms = clock.lapMs();
-  render::ImageRgba image = renderer.renderColor(gpu, spec.camera, target);
-  const double draw_ms = clock.lapMs();
-  render::annotate(image, spec.annotations);
-  io::writePng(o.out, viz::toBgr(image));
-  spdlog::info(
-      "wrote {} ({}x{}, view {}): read {:.0f} ms, scene {:.0f} ms, upload {:.0f} ms, "
-      "draw {:.0f} ms",
-      o.out, width, height, o.view, read_ms, build_ms, upload_ms, draw_ms);
-  return 0;
+  spec = viz::buildRunView(run, view, width, height);
+  return drawToPng(spec, width, height, o, read_ms, clock.lapMs());
 }
 
 }  // namespace

@@ -129,6 +129,8 @@ void heightBar(double lo, double hi, ViewSpec& v) {
       render::Annotations::ColorBar{render::ColorMap::kViridis, lo, hi, "height (m)"};
 }
 
+}  // namespace
+
 // A top-down camera fitted to `box` with the box kept clear of the overlays: the compass and
 // colour bar column at the right edge and the title strip at the top (render::annotationUnitPx).
 // The reserve is in pixels, so it is refitted until the scale settles.
@@ -143,6 +145,8 @@ render::RenderCamera topDownClearOfOverlays(const Eigen::AlignedBox3d& box, int 
   }
   return camera;
 }
+
+namespace {
 
 // Orthographic, north up. Layers by height, since the camera looks straight down: the cloud at
 // its own heights, then (lifted above everything) used fixes, trajectories, outages, rejected and

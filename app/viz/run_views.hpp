@@ -42,6 +42,9 @@ ViewSpec buildRunView(const io::RunFiles& run, RunView view, int width, int heig
 // `gvio render --video --view topdown`.
 ViewSpec buildTopDownMapOnly(io::RunFiles run, int width, int height);
 
+// A top-down camera fitted to `box`, keeping it clear of the compass, colour bar and title.
+render::RenderCamera topDownClearOfOverlays(const Eigen::AlignedBox3d& box, int width, int height);
+
 // Metres one pixel spans at `p_w` (perspective: at its depth; orthographic: everywhere).
 double metresPerPixelAt(const render::RenderCamera& camera, const Eigen::Vector3d& p_w);
 

@@ -11,6 +11,7 @@
 
 #include <cstring>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <set>
 
 #include "export/georef.hpp"
@@ -19,6 +20,7 @@
 #include "io/run_dir.hpp"
 #include "support/fixtures.hpp"
 #include "support/las_reader.hpp"
+#include "viz/merged_view.hpp"
 
 namespace gvio::test {
 namespace {
@@ -171,6 +173,33 @@ TEST_F(CliMerge, TilesTwoDrivesAsLasPcdAndOctomapWithTheirDrives) {
   const YAML::Node projector = YAML::LoadFile((map() / "map_projector_info.yaml").string());
   EXPECT_EQ(projector["projector_type"].as<std::string>(), "LocalCartesianUTM");
   EXPECT_NEAR(projector["map_origin"]["latitude"].as<double>(), georef.enu_origin.lat_deg, 1e-9);
+
+  // gvio render draws the merged map from above, each drive in its colour.
+  const fs::path png = dir_->path() / "merged.png";
+  const CommandResult drawn =
+      runGvio(fmt::format("render --run {} --out {} --size 800x600", quoted(map()), quoted(png)));
+  ASSERT_EQ(drawn.exit_code, 0) << drawn.err;
+  const cv::Mat image = cv::imread(png.string(), cv::IMREAD_COLOR);
+  ASSERT_EQ(image.cols, 800);
+  for (const std::uint16_t id : {1, 2}) {
+    const render::Rgb c = viz::driveColour(id);
+    const cv::Vec3b bgr(static_cast<std::uint8_t>(std::lround(c.b * 255)),
+                        static_cast<std::uint8_t>(std::lround(c.g * 255)),
+                        static_cast<std::uint8_t>(std::lround(c.r * 255)));
+    int count = 0;
+    for (int row = 0; row < image.rows; ++row) {
+      for (int col = 0; col < image.cols; ++col) {
+        const cv::Vec3b p = image.at<cv::Vec3b>(row, col);
+        count += std::abs(p[0] - bgr[0]) + std::abs(p[1] - bgr[1]) + std::abs(p[2] - bgr[2]) < 12;
+      }
+    }
+    EXPECT_GT(count, 500) << "drive " << id;
+  }
+  const CommandResult perspective = runGvio(
+      fmt::format("render --run {} --view perspective --out {}", quoted(map()), quoted(png)));
+  EXPECT_EQ(perspective.exit_code, 2);
+  EXPECT_THAT(perspective.err,
+              HasSubstr("is a merged map (tiles.json): it draws --view topdown only"));
 
   // Merged again with larger tiles: the smaller tiles of the first merge are gone.
   ASSERT_EQ(runGvio(fmt::format("merge --runs {} {} --out {} --tile-size 100", quoted(run(21)),
