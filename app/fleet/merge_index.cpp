@@ -160,9 +160,14 @@ nlohmann::json tilesJson(const std::vector<MergeRun>& runs, const MergeFrame& fr
                                                                static_cast<double>(a.overlap)
                                                          : 0.0},
                         {"median_m", a.medianM()},
+                        {"sample",
+                         {{"stride_at_least", DriveAgreement::kQueryStride},
+                          {"at_most_per_tile", DriveAgreement::kMaxQueriesPerTile}}},
                         {"note",
-                         "each dense point (at least overlap_radius_m inside its tile) against the "
-                         "other drives' dense points: the nearest within overlap_radius_m"}};
+                         "an even sample of the drive's dense points (at least overlap_radius_m "
+                         "inside their tile) against the dense points of the tile's reference "
+                         "drive (the first of the merge with dense points there): the nearest "
+                         "within overlap_radius_m"}};
     }
     drives.push_back(d);
   }

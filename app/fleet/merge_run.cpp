@@ -99,10 +99,10 @@ MergeSummary runMerge(const MergeRequest& request) {
     if (it == summary.agreement.end() || it->second.overlap == 0) continue;
     const DriveAgreement& a = it->second;
     spdlog::info(
-        "merge: {}: {:.1f} % of {} overlapping dense points (a 1-in-{} sample) within {} m of an "
+        "merge: {}: {:.1f} % of {} overlapping dense points (a sample) within {} m of an "
         "earlier drive's (median {:.3f} m)",
         run.name, 100.0 * static_cast<double>(a.within) / static_cast<double>(a.overlap), a.overlap,
-        DriveAgreement::kQueryStride, DriveAgreement::kWithinM, a.medianM());
+        DriveAgreement::kWithinM, a.medianM());
   }
   return summary;
 }

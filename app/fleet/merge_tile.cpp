@@ -201,10 +201,14 @@ void addAgreement(const std::vector<SpillPoint>& points, double tile_size_m,
   for (auto it = std::next(dense.begin()); it != dense.end(); ++it) {
     DriveAgreement& a = agreement[it->first];
     const std::vector<Eigen::Vector3f>& mine = it->second;
-    // A fixed 1-in-kQueryStride sample of the drive's points asks: the percentages of a few
-    // hundred thousand samples are those of all points to well under a percent, at an eighth
-    // of the cost (nearest-neighbour queries are most of a merge's time otherwise).
-    for (std::size_t k = 0; k < mine.size(); k += DriveAgreement::kQueryStride) {
+    // An even sample of the drive's points asks (every kQueryStride-th, at most
+    // kMaxQueriesPerTile a tile): the percentages of the hundreds of thousands of samples a drive
+    // gets are those of all its points to well under a percent, at a fraction of the cost
+    // (nearest-neighbour queries were most of a merge's time).
+    const std::size_t stride = std::max(DriveAgreement::kQueryStride,
+                                        (mine.size() + DriveAgreement::kMaxQueriesPerTile - 1) /
+                                            DriveAgreement::kMaxQueriesPerTile);
+    for (std::size_t k = 0; k < mine.size(); k += stride) {
       const Eigen::Vector3f& m = mine[k];
       const double x = m.x(), y = m.y();
       if (x < r || y < r || x > tile_size_m - r || y > tile_size_m - r) continue;
@@ -246,7 +250,11 @@ TileResult writeTile(const fs::path& out_dir, const MergeFrame& frame, const Til
   t.name = tileName(spill, key);
   const std::vector<SpillPoint> points = spill.read(key);
   t.points = points.size();
-  for (const SpillPoint& p : points) ++t.points_per_drive[p.point_source_id];
+  std::vector<std::uint64_t> per_drive(65536, 0);  // a map lookup per point cost seconds
+  for (const SpillPoint& p : points) ++per_drive[p.point_source_id];
+  for (std::size_t id = 0; id < per_drive.size(); ++id) {
+    if (per_drive[id] != 0) t.points_per_drive[static_cast<std::uint16_t>(id)] = per_drive[id];
+  }
   const fs::path stem = out_dir / "tiles" / t.name;
   const exporter::LasSummary las = exporter::writeLasUtm(
       fs::path(stem).concat(".las"), frame.crs, points.size(),

@@ -16,11 +16,14 @@
 namespace gvio::fleet {
 
 // Agreement of one drive's dense points with the reference drive's (in each tile, the first drive
-// of the merge that has dense points there): for each of its points (every kQueryStride-th) at
+// of the merge that has dense points there): for each of its points (an even sample) at
 // least kOverlapRadiusM inside its tile with a reference point within kOverlapRadiusM (the
 // overlap), the distance to the nearest one; kept as a 1 mm histogram.
 struct DriveAgreement {
-  static constexpr std::size_t kQueryStride = 8;  // every 8th dense point of a tile is compared
+  // A drive's dense points of a tile are sampled evenly: every kQueryStride-th, and at most
+  // kMaxQueriesPerTile of them.
+  static constexpr std::size_t kQueryStride = 8;
+  static constexpr std::size_t kMaxQueriesPerTile = 4000;
   static constexpr double kOverlapRadiusM = 1.0;
   static constexpr double kWithinM = 0.2;
   static constexpr int kBins = 1000;
