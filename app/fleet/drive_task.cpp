@@ -99,7 +99,8 @@ FleetPlan planFromJson(const nlohmann::json& j, const fs::path& file) {
       spec.name = d.at("name").get<std::string>();
       spec.dataset = d.at("dataset").get<std::string>();
       spec.run_args = d.at("run_args").get<std::vector<std::string>>();
-      if (spec.name.empty() || spec.name.find('/') != std::string::npos) {
+      if (spec.name.empty() || spec.name == "." || spec.name == ".." ||
+          spec.name.find('/') != std::string::npos) {
         throw InvalidInput("bad drive name '" + spec.name + "'");
       }
       plan.drives.push_back(std::move(spec));

@@ -76,6 +76,7 @@ const std::vector<Target>& targets() {
     std::vector<Target> list;
     addTextTargets(list);
     addFileTargets(list);
+    addFleetTargets(list);
     return list;
   }();
   return all;
