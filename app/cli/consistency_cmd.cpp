@@ -9,7 +9,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <sstream>
+
 #include "cli/app.hpp"
+#include "fleet/merged_consistency.hpp"
 #include "io/atomic_write.hpp"
 #include "io/input_error.hpp"
 #include "io/mesh_ply.hpp"
@@ -29,8 +32,55 @@ constexpr double kOccupancyWithinVoxels = 2.0;
 struct ConsistencyOptions {
   std::string run, reference;
   std::optional<std::string> json;
+  std::optional<std::string> reference_origin;  // merged maps: the mesh's ENU origin
   double max_distance_m = 2.0;
 };
+
+// Points of a merged map compared at most (thinned evenly per tile).
+constexpr std::size_t kMergedMapPoints = 10'000'000;
+
+// "lat,lon,h" (degrees, degrees, ellipsoidal metres).
+fusion::Lla parseOrigin(const std::string& text) {
+  fusion::Lla lla;
+  char c1 = 0, c2 = 0;
+  std::istringstream in(text);
+  if (!(in >> lla.lat_deg >> c1 >> lla.lon_deg >> c2 >> lla.h_ellipsoid_m) || c1 != ',' ||
+      c2 != ',' || !in.eof() || !fusion::isValidLla(lla)) {
+    throw InvalidInput("--reference-origin '" + text + "': expected lat,lon,h (degrees, metres)");
+  }
+  return lla;
+}
+
+// A `gvio merge` folder: the tiles' points against the mesh, overall and per drive.
+int runMergedConsistency(const ConsistencyOptions& o) {
+  const fleet::MergedMap map = fleet::readMergedMap(o.run, kMergedMapPoints);
+  const nlohmann::json index = io::readJsonObject(fs::path(o.run) / "tiles.json");
+  const fusion::Lla map_origin{index["map_frame"]["origin_lat_deg"].get<double>(),
+                               index["map_frame"]["origin_lon_deg"].get<double>(),
+                               index["map_frame"]["origin_h_ellipsoid_m"].get<double>()};
+  const fusion::Lla mesh_origin =
+      o.reference_origin ? parseOrigin(*o.reference_origin) : map_origin;
+  const io::TriangleMesh mesh =
+      fleet::meshInMapFrame(io::readMeshPly(o.reference), mesh_origin, map);
+  nlohmann::json j =
+      fleet::mergedConsistency(map, mesh, o.max_distance_m, kDenseMedianM, kSparseMedianM);
+  j["run"] = o.run;
+  j["reference"] = {
+      {"file", o.reference},
+      {"triangles", mesh.triangles.size()},
+      {"enu_origin", {mesh_origin.lat_deg, mesh_origin.lon_deg, mesh_origin.h_ellipsoid_m}}};
+  spdlog::info("merged map: {} of {} points compared", map.points.size(), map.total_points);
+  spdlog::info("dense points: {}, median {:.3f} m, p90 {:.3f} m to the reference (target <= {} m)",
+               j["dense"]["n"].get<std::size_t>(), j["dense"]["median_m"].get<double>(),
+               j["dense"]["p90_m"].get<double>(), kDenseMedianM);
+  for (const auto& d : j["drives"]) {
+    spdlog::info("  {} (point source ID {}): {} dense points, median {:.3f} m",
+                 d["name"].get<std::string>(), d["point_source_id"].get<int>(),
+                 d["dense"]["n"].get<std::size_t>(), d["dense"]["median_m"].get<double>());
+  }
+  if (o.json) io::writeTextAtomic(*o.json, j.dump(2) + "\n");
+  return 0;
+}
 
 nlohmann::json distanceJson(const mapping::SurfaceDistanceStats& s, double target_median_m) {
   return {{"n", s.n},
@@ -60,6 +110,12 @@ int runConsistency(const ConsistencyOptions& o) {
   if (!(o.max_distance_m > 0.0)) throw InvalidInput("--max-distance must be > 0");
   const fs::path run(o.run);
   if (!fs::is_directory(run)) throw io::InputError(run, 0, "run folder not found");
+  if (fleet::isMergedMap(run) && !fs::exists(run / "map.pcd")) return runMergedConsistency(o);
+  if (o.reference_origin) {
+    throw InvalidInput(
+        "--reference-origin is for a merged map (gvio merge); a run's reference "
+        "mesh is in its own ENU frame");
+  }
   if (const auto warning = io::incompleteRunWarning(run)) spdlog::warn("{}", *warning);
   const fs::path pcd = run / "map.pcd";
   if (!fs::exists(pcd)) {
@@ -106,12 +162,16 @@ int runConsistency(const ConsistencyOptions& o) {
 Command addConsistencyCommand(CLI::App& app) {
   auto o = std::make_shared<ConsistencyOptions>();
   CLI::App* sub = app.add_subcommand(
-      "consistency", "Compare a run's map (map.pcd, map.bt) with a reference mesh in its frame");
+      "consistency",
+      "Compare a run's map (map.pcd, map.bt) or a merged map (tiles) with a reference mesh");
   sub->add_option("--run", o->run, "Run folder (the --out of gvio run)")->required();
   sub->add_option("--reference", o->reference,
                   "Reference triangle mesh (PLY) in the run's map frame (local ENU)")
       ->required();
   sub->add_option("--json", o->json, "Write the metrics as JSON");
+  sub->add_option("--reference-origin", o->reference_origin,
+                  "Merged maps (gvio merge): the mesh's local ENU origin lat,lon,h (default: the "
+                  "map origin, the first run's ENU origin)");
   sub->add_option("--max-distance", o->max_distance_m,
                   "Search radius (m): points farther from the surface count as this distance")
       ->capture_default_str();

@@ -42,6 +42,7 @@ void readTile(const fs::path& file, std::size_t stride, MergedMap& map) {
   const std::uint32_t y = fieldOffset(cloud, "y", F::FLOAT32, file);
   const std::uint32_t z = fieldOffset(cloud, "z", F::FLOAT32, file);
   const std::uint32_t id = fieldOffset(cloud, "point_source_id", F::UINT16, file);
+  const std::uint32_t kind = fieldOffset(cloud, "source", F::UINT8, file);
   const std::size_t n = std::size_t{cloud.width} * cloud.height;
   if (cloud.data.size() < n * cloud.point_step) throw io::InputError(file, 0, "truncated tile");
   for (std::size_t k = 0; k < n; k += stride) {
@@ -50,11 +51,12 @@ void readTile(const fs::path& file, std::size_t stride, MergedMap& map) {
     std::memcpy(&v[0], p + x, 4);
     std::memcpy(&v[1], p + y, 4);
     std::memcpy(&v[2], p + z, 4);
-    std::uint16_t source = 0;
-    std::memcpy(&source, p + id, 2);
+    std::uint16_t drive = 0;
+    std::memcpy(&drive, p + id, 2);
     if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) continue;
     map.points.emplace_back(v[0], v[1], v[2]);
-    map.point_source_id.push_back(source);
+    map.point_source_id.push_back(drive);
+    map.source.push_back(p[kind]);
   }
 }
 
@@ -130,6 +132,12 @@ MergedMap readMergedMap(const fs::path& dir, std::size_t max_points) {
   }
   if (!(map.tile_size_m > 0.0) || frame.zone < 1 || frame.zone > 60) {
     throw io::InputError(index_file, 0, "not a gvio merge index: bad tile size or UTM zone");
+  }
+  map.utm_zone = frame.zone;
+  map.utm_north = frame.north;
+  map.origin_utm = {frame.origin_e, frame.origin_n, frame.origin_h};
+  if (!map.origin_utm.allFinite()) {
+    throw io::InputError(index_file, 0, "not a gvio merge index: map origin not finite");
   }
   const std::size_t stride =
       max_points == 0 ? 1

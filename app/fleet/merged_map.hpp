@@ -31,7 +31,11 @@ struct MergedMap {
   std::vector<MergedDrive> drives;
   std::vector<Eigen::Vector3f> points;         // map frame
   std::vector<std::uint16_t> point_source_id;  // one per point
-  std::uint64_t total_points = 0;              // before thinning
+  std::vector<std::uint8_t> source;            // one per point: 0 sparse landmark, 1 dense
+  int utm_zone = 0;
+  bool utm_north = true;
+  Eigen::Vector3d origin_utm = Eigen::Vector3d::Zero();  // the map frame's origin: E, N, h
+  std::uint64_t total_points = 0;                        // before thinning
 };
 
 // Whether `dir` is a merged map (holds tiles.json).

@@ -33,7 +33,8 @@ class CliMerge : public ::testing::Test {
     dir_ = new TempDir("cli_merge");
     for (const int seed : {21, 22}) {
       const fs::path sim = cachedSimulation(fmt::format(
-          "--trajectory {}/assets/demo/drive.tum --seconds 10 --seed {}", GVIO_SOURCE_DIR, seed));
+          "--trajectory {}/assets/demo/drive.tum --seconds 10 --seed {} --gnss-noise rtk",
+          GVIO_SOURCE_DIR, seed));
       const CommandResult r = runGvio(fmt::format("run --dataset {} --out {} --no-progress {}",
                                                   quoted(sim), quoted(run(seed)), kSimGeo));
       ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -200,6 +201,34 @@ TEST_F(CliMerge, TilesTwoDrivesAsLasPcdAndOctomapWithTheirDrives) {
   EXPECT_EQ(perspective.exit_code, 2);
   EXPECT_THAT(perspective.err,
               HasSubstr("is a merged map (tiles.json): it draws --view topdown only"));
+
+  // gvio consistency: the merged points against the simulator's world of the second drive (in
+  // the ENU frame of the simulator's origin, the runs' origin: the default), overall and per
+  // drive. That drive's points lie as close to it as its run's own map.pcd does; the same mesh
+  // 3 m higher is farther.
+  const fs::path world =
+      cachedSimulation(fmt::format(
+          "--trajectory {}/assets/demo/drive.tum --seconds 10 --seed 22 --gnss-noise rtk",
+          GVIO_SOURCE_DIR)) /
+      "world/world.ply";
+  const auto consistency = [&](const fs::path& run_or_map, const std::string& extra) {
+    const fs::path json = dir_->path() / "consistency.json";
+    const CommandResult c =
+        runGvio(fmt::format("consistency --run {} --reference {} --json {} {}", quoted(run_or_map),
+                            quoted(world), quoted(json), extra));
+    EXPECT_EQ(c.exit_code, 0) << c.err;
+    return io::readJsonObject(json);
+  };
+  const nlohmann::json fit = consistency(map(), "");
+  EXPECT_EQ(fit["points_read"], expected);
+  ASSERT_EQ(fit["drives"].size(), 2U);
+  EXPECT_GT(fit["dense"]["n"].get<std::size_t>(), expected / 2);
+  const double second = fit["drives"][1]["dense"]["median_m"].get<double>();
+  const double own = consistency(run(22), "")["dense"]["median_m"].get<double>();
+  EXPECT_NEAR(second, own, 0.01);
+  EXPECT_LT(second, 1.0);
+  const nlohmann::json moved = consistency(map(), "--reference-origin 48.98253,8.39035,119.4");
+  EXPECT_GT(moved["drives"][1]["dense"]["median_m"].get<double>(), second + 0.3);
 
   // Merged again with larger tiles: the smaller tiles of the first merge are gone.
   ASSERT_EQ(runGvio(fmt::format("merge --runs {} {} --out {} --tile-size 100", quoted(run(21)),
