@@ -3,8 +3,6 @@
 #include <octomap/OcTree.h>
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
-#include <pcl/kdtree/kdtree_flann.h>
-#include <pcl/point_types.h>
 
 #include <fmt/format.h>
 
@@ -12,7 +10,7 @@
 #include <cstring>
 #include <limits>
 #include <optional>
-#include <unordered_set>
+#include <unordered_map>
 
 #include "export/las_writer.hpp"
 #include "io/atomic_write.hpp"
@@ -88,6 +86,25 @@ void writeTilePcd(const fs::path& file, const MergeFrame& frame, const TileSpill
   });
 }
 
+// Sorts keys of 48 bits: three counting passes of 16 bits (LSD radix sort), several times faster
+// than a comparison sort for the millions of voxel keys of a tile.
+void radixSort48(std::vector<std::uint64_t>& keys) {
+  std::vector<std::uint64_t> buffer(keys.size());
+  std::vector<std::size_t> count(1 << 16);
+  for (int shift = 0; shift < 48; shift += 16) {
+    std::fill(count.begin(), count.end(), 0);
+    for (const std::uint64_t k : keys) ++count[(k >> shift) & 0xFFFF];
+    std::size_t sum = 0;
+    for (auto& c : count) {
+      const std::size_t n = c;
+      c = sum;
+      sum += n;
+    }
+    for (const std::uint64_t k : keys) buffer[count[(k >> shift) & 0xFFFF]++] = k;
+    keys.swap(buffer);
+  }
+}
+
 // Occupied voxels where points fall (no free space: the points carry no sensor origin). Each
 // voxel is updated once however many points it holds (the tile's keys are sorted and made
 // unique first), which is what makes this fast.
@@ -115,7 +132,7 @@ std::size_t writeTileOctomap(const fs::path& file, const MergeFrame& frame, cons
     const std::uint64_t v = (std::uint64_t{k[0]} << 32) | (std::uint64_t{k[1]} << 16) | k[2];
     if (packed.empty() || packed.back() != v) packed.push_back(v);
   }
-  std::sort(packed.begin(), packed.end());
+  radixSort48(packed);
   packed.erase(std::unique(packed.begin(), packed.end()), packed.end());
   for (const std::uint64_t v : packed) {
     const octomap::OcTreeKey k(static_cast<octomap::key_type>(v >> 32),
@@ -132,58 +149,71 @@ std::size_t writeTileOctomap(const fs::path& file, const MergeFrame& frame, cons
   return packed.size();
 }
 
-// The nearest point within `radius` of a query. FLANN's nearest-neighbour search is fast where
-// a neighbour is near and slow where none is (it visits much of the tree), and a radius search
-// visits every point within the radius (hundreds in a dense map): so a hash of the radius-sized
-// cubes that hold points first tells whether any point can be within the radius (one of the 27
-// cubes around the query is occupied), and only then does FLANN look for the nearest.
-class RadiusGrid {
+// Points hashed into cubes of one size: the 27 cubes around a query hold every point within
+// that size of it.
+class CubeHash {
  public:
-  RadiusGrid(const std::vector<Eigen::Vector3f>& points, double radius_m) : radius_(radius_m) {
-    auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-    cloud->reserve(points.size());
-    for (const auto& p : points) {
-      cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-      occupied_.insert(key(cube(p)));
+  CubeHash(const std::vector<Eigen::Vector3f>& points, double cube_m)
+      : points_(points), cube_m_(cube_m) {
+    cubes_.reserve(points.size() / 4 + 1);
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      cubes_[key(cube(points[k]))].push_back(static_cast<std::uint32_t>(k));
     }
-    tree_.setInputCloud(cloud);
   }
-  [[nodiscard]] std::optional<double> nearest(const Eigen::Vector3f& q) const {
-    if (!anyNear(q)) return std::nullopt;
-    pcl::Indices index(1);
-    std::vector<float> d2(1);
-    if (tree_.nearestKSearch(pcl::PointXYZ(q.x(), q.y(), q.z()), 1, index, d2) < 1) {
-      return std::nullopt;
-    }
-    const double d = std::sqrt(static_cast<double>(d2[0]));
-    if (d > radius_) return std::nullopt;
-    return d;
-  }
-
- private:
-  [[nodiscard]] bool anyNear(const Eigen::Vector3f& q) const {
+  // The squared distance to the nearest point within the cube size, or +inf.
+  [[nodiscard]] double nearest2(const Eigen::Vector3f& q) const {
     const Eigen::Vector3i c = cube(q);
+    double best2 = cube_m_ * cube_m_;
+    bool found = false;
     for (int dx = -1; dx <= 1; ++dx) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dz = -1; dz <= 1; ++dz) {
-          if (occupied_.count(key(c + Eigen::Vector3i(dx, dy, dz))) != 0) return true;
+          const auto it = cubes_.find(key(c + Eigen::Vector3i(dx, dy, dz)));
+          if (it == cubes_.end()) continue;
+          for (const std::uint32_t k : it->second) {
+            const double d2 = (points_[k] - q).cast<double>().squaredNorm();
+            if (d2 <= best2) {
+              best2 = d2;
+              found = true;
+            }
+          }
         }
       }
     }
-    return false;
+    return found ? best2 : std::numeric_limits<double>::infinity();
   }
+
+ private:
   [[nodiscard]] Eigen::Vector3i cube(const Eigen::Vector3f& p) const {
-    return (p.cast<double>() / radius_).array().floor().cast<int>();
+    return (p.cast<double>() / cube_m_).array().floor().cast<int>();
   }
   static std::uint64_t key(const Eigen::Vector3i& c) {
     // 21 bits a coordinate: a tile's cubes lie well within +-2^20 of its corner.
     const auto part = [](int v) { return static_cast<std::uint64_t>(v + (1 << 20)) & 0x1FFFFF; };
     return (part(c.x()) << 42) | (part(c.y()) << 21) | part(c.z());
   }
+  const std::vector<Eigen::Vector3f>& points_;
+  double cube_m_;
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cubes_;
+};
 
-  double radius_;
-  std::unordered_set<std::uint64_t> occupied_;
-  pcl::KdTreeFLANN<pcl::PointXYZ> tree_;
+// The nearest point within `radius` of a query, exactly: a hash of fine cubes (radius / 4)
+// answers the queries with a near neighbour from a few points, one of radius-sized cubes the
+// rest. Cheaper to build than a k-d tree, which matters more than the query (a sample of a few
+// thousand points a tile asks, against all of the reference drive's points).
+class RadiusGrid {
+ public:
+  RadiusGrid(const std::vector<Eigen::Vector3f>& points, double radius_m)
+      : fine_(points, radius_m / 4.0), coarse_(points, radius_m) {}
+  [[nodiscard]] std::optional<double> nearest(const Eigen::Vector3f& q) const {
+    double d2 = fine_.nearest2(q);
+    if (!std::isfinite(d2)) d2 = coarse_.nearest2(q);
+    if (!std::isfinite(d2)) return std::nullopt;
+    return std::sqrt(d2);
+  }
+
+ private:
+  CubeHash fine_, coarse_;
 };
 
 // Each drive's dense points (away from the border) against the reference drive's: the tile's
