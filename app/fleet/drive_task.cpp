@@ -198,9 +198,23 @@ void writeTaskRecord(const FleetPlan& plan, std::size_t i, const DriveResult& r)
   io::writeTextAtomic(plan.taskFile(i), resultToJson(r).dump(2) + "\n");
 }
 
+// A command without its --threads: a run's outputs do not depend on it (gvio run --threads), and
+// it follows the fleet's --jobs, which a later fleet may choose differently.
+std::vector<std::string> withoutThreads(std::vector<std::string> argv) {
+  for (std::size_t k = 0; k + 1 < argv.size(); ++k) {
+    if (argv[k] == "--threads") {
+      argv.erase(argv.begin() + static_cast<std::ptrdiff_t>(k),
+                 argv.begin() + static_cast<std::ptrdiff_t>(k) + 2);
+      break;
+    }
+  }
+  return argv;
+}
+
 bool alreadyComplete(const FleetPlan& plan, std::size_t i) {
   const auto record = readTaskRecord(plan, i);
-  if (!record || record->state != DriveState::kComplete || record->argv != plan.runArgv(i)) {
+  if (!record || record->state != DriveState::kComplete ||
+      withoutThreads(record->argv) != withoutThreads(plan.runArgv(i))) {
     return false;
   }
   const auto report = readReport(plan.runDir(i));

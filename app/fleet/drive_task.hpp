@@ -66,8 +66,8 @@ DriveResult describeExit(const FleetPlan& plan, std::size_t i, const ChildExit& 
 std::optional<DriveResult> readTaskRecord(const FleetPlan& plan, std::size_t i);
 void writeTaskRecord(const FleetPlan& plan, std::size_t i, const DriveResult& r);
 
-// A drive an earlier fleet completed with the same command, whose run folder still says
-// "complete": it is not run again.
+// A drive an earlier fleet completed with the same command (its --threads aside), whose run
+// folder still says "complete": it is not run again.
 bool alreadyComplete(const FleetPlan& plan, std::size_t i);
 
 // Starts drive i's `gvio run` as a child process (its log gets an attempt header first).
