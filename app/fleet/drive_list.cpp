@@ -24,8 +24,10 @@ fs::path resolve(const fs::path& base, const std::string& word) {
 }
 
 std::string defaultName(const fs::path& dataset) {
-  fs::path p = dataset;
-  while (!p.empty() && p.filename().empty()) p = p.parent_path();  // "drive/" -> "drive"
+  fs::path p = dataset.lexically_normal();
+  // "drive/" -> "drive"; the root ("/") has no name (the caller asks for --name), and its parent
+  // is itself, so this is no loop (a fuzzer found that one).
+  if (p.filename().empty() && p.has_relative_path()) p = p.parent_path();
   if (p.extension() == ".bag") return p.stem().string();
   return p.filename().string();
 }

@@ -27,9 +27,10 @@ MergeRun readRun(const fs::path& dir) {
   MergeRun run;
   run.dir = fs::absolute(dir).lexically_normal();
   run.georef = exporter::readGeoref(georef);
-  fs::path name = run.dir;
-  while (!name.empty() && name.filename().empty()) name = name.parent_path();
+  fs::path name = run.dir;  // lexically normal: "run/" -> "run"; "/" keeps no name
+  if (name.filename().empty() && name.has_relative_path()) name = name.parent_path();
   run.name = name.filename().string();
+  if (run.name.empty()) run.name = "run";
   return run;
 }
 

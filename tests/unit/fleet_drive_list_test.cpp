@@ -62,6 +62,8 @@ TEST(DriveList, RejectsWhatTheFleetSetsAndAmbiguousNamesWithTheLine) {
   EXPECT_THAT(errorOf("--gnss off\n"), HasSubstr("drives.txt:1: expected a dataset first"));
   EXPECT_THAT(errorOf("a 'b\n"), HasSubstr("drives.txt:1: unterminated quote"));
   EXPECT_THAT(errorOf("# nothing\n\n"), HasSubstr("drives.txt: no drive in the list"));
+  // The root has no name (and its parent is itself: a fuzzer found a hang there).
+  EXPECT_THAT(errorOf("/\n"), HasSubstr("drives.txt:1: cannot name a run folder ''"));
   EXPECT_EQ(errorOf("x/a\ny/a --name b\n"), "");
 }
 
