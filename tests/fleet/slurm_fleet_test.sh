@@ -50,12 +50,12 @@ munged --foreground --force --key-file="$c/munge/munge.key" --socket="$c/munge/m
   --pid-file="$c/munge/munged.pid" --log-file="$c/log/munged.log" --seed-file="$c/munge/seed" \
   >>"$c/log/munged.out" 2>&1 &
 pids+=($!)
-host=$(hostname -s)
+host=$(hostname -s)  # both daemons on the loopback: no DNS needed for the node's name
 port=$((20000 + RANDOM % 30000))
 memory_mb=$(($(awk '/MemTotal/ {print int($2 / 1024)}' /proc/meminfo) - 512))
 cat >"$c/slurm.conf" <<CONF
 ClusterName=gviotest
-SlurmctldHost=$host
+SlurmctldHost=$host(127.0.0.1)
 SlurmUser=root
 SlurmdUser=root
 SlurmctldPort=$port
@@ -79,7 +79,7 @@ ReturnToService=2
 SchedulerType=sched/backfill
 SelectType=select/cons_tres
 SelectTypeParameters=CR_Core
-NodeName=$host CPUs=$(nproc) RealMemory=$memory_mb State=UNKNOWN
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$(nproc) RealMemory=$memory_mb State=UNKNOWN
 PartitionName=gvio Nodes=$host Default=YES MaxTime=INFINITE State=UP
 CONF
 echo "CgroupPlugin=cgroup/v1" >"$c/cgroup.conf"
