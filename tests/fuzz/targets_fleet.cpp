@@ -55,25 +55,16 @@ constexpr const char* kTilePcd =
     "COUNT 1 1 1 1 1 1\nWIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n"
     "1 2 0.5 100 1 1\n-3 4 0.25 50 1 0\n";
 
-Target text(std::string name, std::string file, std::string seed,
-            std::function<void(const fs::path&)> read) {
-  std::string path = file;
-  return Target{
-      std::move(name), std::move(file),
-      [seed = std::move(seed), path](const fs::path& dir) { test::writeText(dir / path, seed); },
-      std::move(read), ""};
-}
-
 }  // namespace
 
 void addFleetTargets(std::vector<Target>& out) {
-  out.push_back(text("drive_list", "drives.txt", kDriveList, [](const fs::path& d) {
+  out.push_back(plain("drive_list", "drives.txt", kDriveList, [](const fs::path& d) {
     for (const auto& drive : fleet::readDriveList(d / "drives.txt")) {
       require(!drive.name.empty() && drive.name.find('/') == std::string::npos, "bad run name");
       require(drive.dataset.is_absolute(), "dataset not absolute");
     }
   }));
-  out.push_back(text("fleet_plan", "fleet_plan.json", kPlan, [](const fs::path& d) {
+  out.push_back(plain("fleet_plan", "fleet_plan.json", kPlan, [](const fs::path& d) {
     const fs::path file = d / "fleet_plan.json";
     const fleet::FleetPlan plan = fleet::planFromJson(io::readJsonObject(file), file);
     for (std::size_t i = 0; i < plan.drives.size(); ++i) {
@@ -81,7 +72,7 @@ void addFleetTargets(std::vector<Target>& out) {
       require(!plan.runArgv(i).empty(), "empty command");
     }
   }));
-  Target tiles = text("tiles_json", "tiles.json", kTilesJson, [](const fs::path& d) {
+  Target tiles = plain("tiles_json", "tiles.json", kTilesJson, [](const fs::path& d) {
     const fleet::MergedMap map = fleet::readMergedMap(d, 1000);
     require(map.points.size() == map.point_source_id.size(), "points without drive");
     for (const auto& p : map.points) require(p.allFinite(), "non-finite point");

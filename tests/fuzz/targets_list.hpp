@@ -1,5 +1,7 @@
 #pragma once
 // The groups of fuzz targets (harness.hpp targets() lists them all).
+#include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -8,6 +10,9 @@
 namespace gvio::fuzz {
 
 void addTextTargets(std::vector<Target>& out);  // targets_text.cpp
+// A target whose input is one file with `seed` as its valid instance (targets_text.cpp).
+Target plain(std::string name, std::string file, std::string seed,
+             std::function<void(const std::filesystem::path&)> read);
 // A Kalibr camchain of a 32 x 16 px radtan stereo pair on /cam0/image_raw, /cam1/image_raw.
 std::string smallCamchainYaml();
 void addFileTargets(std::vector<Target>& out);   // targets_files.cpp

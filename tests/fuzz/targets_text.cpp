@@ -35,14 +35,6 @@ using io::TrajectoryFormat;
 namespace {
 
 // A file of its own: prepare() writes `seed` as `name`.
-Target plain(std::string name, std::string file, std::string seed,
-             std::function<void(const fs::path&)> read) {
-  std::string path = file;
-  return Target{
-      std::move(name), std::move(file),
-      [seed = std::move(seed), path](const fs::path& dir) { test::writeText(dir / path, seed); },
-      std::move(read), ""};
-}
 
 // A 3-pose trajectory: stamps, then positions and unit quaternions.
 Trajectory smallTrajectory() {
@@ -130,6 +122,15 @@ constexpr const char* kNoise =
     "quality: 1\n";
 
 }  // namespace
+
+Target plain(std::string name, std::string file, std::string seed,
+             std::function<void(const fs::path&)> read) {
+  std::string path = file;
+  return Target{
+      std::move(name), std::move(file),
+      [seed = std::move(seed), path](const fs::path& dir) { test::writeText(dir / path, seed); },
+      std::move(read), ""};
+}
 
 std::string smallCamchainYaml() {
   CameraModel c;
