@@ -82,20 +82,6 @@ int runMergedConsistency(const ConsistencyOptions& o) {
   return 0;
 }
 
-nlohmann::json distanceJson(const mapping::SurfaceDistanceStats& s, double target_median_m) {
-  return {{"n", s.n},
-          {"median_m", s.median_m},
-          {"mean_m", s.mean_m},
-          {"p90_m", s.p90_m},
-          {"rmse_m", s.rmse_m},
-          {"within_m", s.within_m},
-          {"fraction_within", s.fraction_within},
-          {"beyond_max_distance", s.far},
-          {"max_distance_m", s.max_distance_m},
-          {"target_median_m", target_median_m},
-          {"meets_target", s.n > 0 && s.median_m <= target_median_m}};
-}
-
 // map.bt (the maximum-likelihood OcTree); nullopt when the run wrote none.
 std::unique_ptr<octomap::OcTree> readOcTree(const fs::path& file) {
   if (!fs::exists(file)) return nullptr;
@@ -134,8 +120,8 @@ int runConsistency(const ConsistencyOptions& o) {
   j["reference"] = {{"file", o.reference}, {"triangles", surface.triangleCount()}};
   const auto d = mapping::cloudToSurface(surface, dense, o.max_distance_m, kDenseMedianM);
   const auto s = mapping::cloudToSurface(surface, sparse, o.max_distance_m, kSparseMedianM);
-  j["dense"] = distanceJson(d, kDenseMedianM);
-  j["sparse"] = distanceJson(s, kSparseMedianM);
+  j["dense"] = fleet::surfaceStatsJson(d, kDenseMedianM);
+  j["sparse"] = fleet::surfaceStatsJson(s, kSparseMedianM);
   spdlog::info("dense points: {} , median {:.3f} m, p90 {:.3f} m to the reference (target <= {} m)",
                d.n, d.median_m, d.p90_m, kDenseMedianM);
   spdlog::info("sparse landmarks: {}, median {:.3f} m, p90 {:.3f} m (target <= {} m)", s.n,

@@ -6,9 +6,8 @@
 #include "mapping/consistency.hpp"
 
 namespace gvio::fleet {
-namespace {
 
-nlohmann::json statsJson(const mapping::SurfaceDistanceStats& s, double target_median_m) {
+nlohmann::json surfaceStatsJson(const mapping::SurfaceDistanceStats& s, double target_median_m) {
   return {{"n", s.n},
           {"median_m", s.median_m},
           {"mean_m", s.mean_m},
@@ -21,8 +20,6 @@ nlohmann::json statsJson(const mapping::SurfaceDistanceStats& s, double target_m
           {"target_median_m", target_median_m},
           {"meets_target", s.n > 0 && s.median_m <= target_median_m}};
 }
-
-}  // namespace
 
 io::TriangleMesh meshInMapFrame(io::TriangleMesh mesh, const fusion::Lla& mesh_origin,
                                 const MergedMap& map) {
@@ -49,10 +46,10 @@ nlohmann::json mergedConsistency(const MergedMap& map, const io::TriangleMesh& m
   nlohmann::json j;
   j["points_read"] = map.points.size();
   j["points_in_map"] = map.total_points;
-  j["dense"] = statsJson(mapping::cloudToSurface(surface, dense, max_distance_m, dense_target_m),
-                         dense_target_m);
-  j["sparse"] = statsJson(mapping::cloudToSurface(surface, sparse, max_distance_m, sparse_target_m),
-                          sparse_target_m);
+  j["dense"] = surfaceStatsJson(
+      mapping::cloudToSurface(surface, dense, max_distance_m, dense_target_m), dense_target_m);
+  j["sparse"] = surfaceStatsJson(
+      mapping::cloudToSurface(surface, sparse, max_distance_m, sparse_target_m), sparse_target_m);
   nlohmann::json drives = nlohmann::json::array();
   for (const auto& d : map.drives) {
     const auto it = per_drive.find(d.point_source_id);
@@ -61,7 +58,7 @@ nlohmann::json mergedConsistency(const MergedMap& map, const io::TriangleMesh& m
         max_distance_m, dense_target_m);
     drives.push_back({{"point_source_id", d.point_source_id},
                       {"name", d.name},
-                      {"dense", statsJson(stats, dense_target_m)}});
+                      {"dense", surfaceStatsJson(stats, dense_target_m)}});
   }
   j["drives"] = drives;
   return j;

@@ -9,8 +9,13 @@
 #include "fleet/merged_map.hpp"
 #include "fusion/geodesy.hpp"
 #include "io/mesh_ply.hpp"
+#include "mapping/consistency.hpp"
 
 namespace gvio::fleet {
+
+// Point-to-surface statistics as `gvio consistency --json` writes them, the median judged
+// against `target_median_m` (a run's consistency and a merged map's).
+nlohmann::json surfaceStatsJson(const mapping::SurfaceDistanceStats& s, double target_median_m);
 
 // The mesh's vertices in the map's frame.
 io::TriangleMesh meshInMapFrame(io::TriangleMesh mesh, const fusion::Lla& mesh_origin,
