@@ -5,8 +5,6 @@
 namespace gvio::fusion {
 namespace {
 
-constexpr double kFalseNorthingSouthM = 10'000'000.0;
-
 // Two 32-bit cell indices in one key (grids span far less than 2^31 cells).
 std::uint64_t key(std::int64_t i, std::int64_t j) {
   return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(i)) << 32) |
@@ -20,11 +18,8 @@ EnuToUtmGrid::EnuToUtmGrid(const Lla& enu_origin, int zone, bool north, double c
 
 Eigen::Vector3d EnuToUtmGrid::exactUtm(const Eigen::Vector3d& p_enu) const {
   const Lla lla = enu_.toLla(p_enu);
-  const Utm utm = llaToUtm(lla, zone_);
-  double northing = utm.northing_m;
-  if (utm.north && !north_) northing += kFalseNorthingSouthM;
-  if (!utm.north && north_) northing -= kFalseNorthingSouthM;
-  return {utm.easting_m, northing, lla.h_ellipsoid_m};
+  const Utm utm = llaToUtm(lla, zone_, north_);
+  return {utm.easting_m, utm.northing_m, lla.h_ellipsoid_m};
 }
 
 const EnuToUtmGrid::Corner& EnuToUtmGrid::corner(std::int64_t i, std::int64_t j) {

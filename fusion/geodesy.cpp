@@ -77,6 +77,15 @@ Utm llaToUtm(const Lla& lla, int zone) {
   return utm;
 }
 
+Utm llaToUtm(const Lla& lla, int zone, bool north) {
+  constexpr double kFalseNorthingSouthM = 10'000'000.0;
+  Utm utm = llaToUtm(lla, zone);
+  if (utm.north && !north) utm.northing_m += kFalseNorthingSouthM;
+  if (!utm.north && north) utm.northing_m -= kFalseNorthingSouthM;
+  utm.north = north;
+  return utm;
+}
+
 Lla utmToLla(const Utm& utm, double h_ellipsoid_m) {
   Lla lla;
   lla.h_ellipsoid_m = h_ellipsoid_m;

@@ -48,6 +48,9 @@ struct Utm {
 Utm llaToUtm(const Lla& lla);
 // Forces a zone (e.g. one zone for a whole map that straddles a boundary).
 Utm llaToUtm(const Lla& lla, int zone);
+// Forces a zone and the grid of one hemisphere: a point across the equator keeps that grid's
+// false northing (northing below 0, or above 10 000 km), so one map stays one continuous grid.
+Utm llaToUtm(const Lla& lla, int zone, bool north);
 Lla utmToLla(const Utm& utm, double h_ellipsoid_m);
 
 }  // namespace gvio::fusion

@@ -30,7 +30,6 @@ constexpr std::uint16_t kPointSize = 30;
 // point formats 6-10 require (GeoTIFF keys are not allowed with them).
 constexpr std::uint16_t kGlobalEncoding = 0x1 | 0x8 | 0x10;
 constexpr std::uint16_t kWktRecordId = 2112;  // "OGC Coordinate System WKT"
-constexpr double kFalseNorthingSouthM = 10'000'000.0;
 
 class Bytes {
  public:
@@ -163,11 +162,8 @@ void putPoint(Bytes& b, const Eigen::Matrix<std::int32_t, 3, 1>& xyz, const LasU
 Eigen::Vector3d enuToUtm(const fusion::EnuFrame& enu, const Eigen::Vector3d& p_enu, int zone,
                          bool north) {
   const fusion::Lla lla = enu.toLla(p_enu);
-  const fusion::Utm utm = fusion::llaToUtm(lla, zone);
-  double northing = utm.northing_m;
-  if (utm.north && !north) northing += kFalseNorthingSouthM;
-  if (!utm.north && north) northing -= kFalseNorthingSouthM;
-  return {utm.easting_m, northing, lla.h_ellipsoid_m};
+  const fusion::Utm utm = fusion::llaToUtm(lla, zone, north);
+  return {utm.easting_m, utm.northing_m, lla.h_ellipsoid_m};
 }
 
 LasSummary writeLasUtm(const std::filesystem::path& file, const fusion::Utm& crs, std::size_t n,

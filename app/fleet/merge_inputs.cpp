@@ -99,8 +99,7 @@ MergeFrame chooseMergeFrame(const std::vector<MergeRun>& runs, const MergeConfig
   const MergeRun& first = runs.front();
   MergeFrame frame;
   frame.map_origin = first.georef.enu_origin;
-  frame.crs = fusion::llaToUtm(frame.map_origin, first.georef.utm_zone);
-  frame.crs.north = first.georef.utm_north;
+  frame.crs = fusion::llaToUtm(frame.map_origin, first.georef.utm_zone, first.georef.utm_north);
   for (const auto& run : runs) {
     if (run.georef.utm_zone == frame.crs.zone && run.georef.utm_north == frame.crs.north) continue;
     const double km = kmOutsideZone(run.georef.enu_origin, frame.crs.zone);
@@ -116,11 +115,7 @@ MergeFrame chooseMergeFrame(const std::vector<MergeRun>& runs, const MergeConfig
                  run.name, run.georef.utm_zone, run.georef.utm_north ? "N" : "S", frame.crs.zone,
                  frame.crs.north ? "N" : "S", km);
   }
-  double northing = frame.crs.northing_m;
-  const fusion::Utm standard = fusion::llaToUtm(frame.map_origin, frame.crs.zone);
-  if (standard.north && !frame.crs.north) northing += 10'000'000.0;
-  if (!standard.north && frame.crs.north) northing -= 10'000'000.0;
-  frame.origin_utm = {frame.crs.easting_m, northing, frame.map_origin.h_ellipsoid_m};
+  frame.origin_utm = {frame.crs.easting_m, frame.crs.northing_m, frame.map_origin.h_ellipsoid_m};
   return frame;
 }
 

@@ -73,11 +73,8 @@ void readTracks(const fs::path& file, const Frame& frame, MergedMap& map) {
         for (const auto& c : f.at("geometry").at("coordinates")) {
           const fusion::Lla lla{c.at(1).get<double>(), c.at(0).get<double>(),
                                 c.size() > 2 ? c.at(2).get<double>() : frame.origin_h};
-          fusion::Utm utm = fusion::llaToUtm(lla, frame.zone);
-          double northing = utm.northing_m;
-          if (utm.north && !frame.north) northing += 10'000'000.0;
-          if (!utm.north && frame.north) northing -= 10'000'000.0;
-          d.track_map.emplace_back(utm.easting_m - frame.origin_e, northing - frame.origin_n,
+          const fusion::Utm utm = fusion::llaToUtm(lla, frame.zone, frame.north);
+          d.track_map.emplace_back(utm.easting_m - frame.origin_e, utm.northing_m - frame.origin_n,
                                    lla.h_ellipsoid_m - frame.origin_h);
         }
       }
