@@ -44,6 +44,11 @@ std::optional<nlohmann::json> readReport(const fs::path& run_dir) {
   }
 }
 
+// What gvio run writes last of all (run/run_status.hpp): the folder holds a whole run.
+bool saysComplete(const std::optional<nlohmann::json>& report) {
+  return report && report->value("status", "") == "complete";
+}
+
 }  // namespace
 
 fs::path FleetPlan::runDir(std::size_t i) const {
@@ -163,8 +168,7 @@ DriveResult describeExit(const FleetPlan& plan, std::size_t i, const ChildExit& 
   r.peak_rss_mb = exit.peak_rss_mb;
   r.argv = plan.runArgv(i);
   const auto report = readReport(plan.runDir(i));
-  const bool complete = report && report->value("status", "") == "complete";
-  if (exit.exit_code == 0 && complete) {
+  if (exit.exit_code == 0 && saysComplete(report)) {
     r.state = DriveState::kComplete;
     readApe(*report, r);
     return r;
@@ -217,8 +221,7 @@ bool alreadyComplete(const FleetPlan& plan, std::size_t i) {
       withoutThreads(record->argv) != withoutThreads(plan.runArgv(i))) {
     return false;
   }
-  const auto report = readReport(plan.runDir(i));
-  return report && report->value("status", "") == "complete";
+  return saysComplete(readReport(plan.runDir(i)));
 }
 
 pid_t startDrive(const FleetPlan& plan, std::size_t i, int attempt) {

@@ -48,11 +48,12 @@ fs::path taskOutput(const FleetPlan& plan, int attempt, std::size_t i) {
   return slurmDir(plan) / fmt::format("attempt{}_task{}.out", attempt, i);
 }
 
-std::string firstLine(const fs::path& file) {
-  std::ifstream in(file);
+// The job id sbatch --parsable printed first: "id" or "id;cluster"; "" before it did.
+std::string jobIdIn(const fs::path& sbatch_out) {
+  std::ifstream in(sbatch_out);
   std::string line;
   std::getline(in, line);
-  return line;
+  return line.substr(0, line.find(';'));
 }
 
 // scancel of the array job, waited for (a signal to the fleet must not leave tasks queued).
@@ -110,14 +111,14 @@ SlurmSubmission runSlurm(const EngineRequest& request, const SlurmConfig& slurm)
   while (!(exit = waitChild(pid))) {
     if (errno != EINTR) throw std::runtime_error("lost the sbatch process");
     const int signal = request.pending_signal ? request.pending_signal() : 0;
-    const std::string job = firstLine(out).substr(0, firstLine(out).find(';'));
-    if (signal != 0 && !cancelled && !job.empty()) {
+    const std::string job = signal != 0 && !cancelled ? jobIdIn(out) : std::string();
+    if (!job.empty()) {
       cancel(job, slurmDir(plan) / "scancel.log");
       cancelled = true;
     }
   }
   SlurmSubmission submission;
-  submission.job_id = firstLine(out).substr(0, firstLine(out).find(';'));  // "id" or "id;cluster"
+  submission.job_id = jobIdIn(out);
   if (submission.job_id.empty()) {
     std::string why = lastErrorLine(err);
     if (why.empty()) why = fmt::format("sbatch exited with code {}", exit->exit_code);
