@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 
 #include "fusion/gnss_factors.hpp"
 #include "fusion/graph_window.hpp"
@@ -47,6 +48,11 @@ FusionMode parseFusionMode(const std::string& name) {
   throw InvalidInput("fusion mode must be kf or graph (got '" + name + "')");
 }
 
+double FusionConfig::tiltSigmaRad() const {
+  return alignment == AlignmentDof::kYawTranslation ? tilt_sigma_deg * std::numbers::pi / 180.0
+                                                    : 0.0;
+}
+
 void FusionConfig::validate() const {
   const auto positive = [](double v, const char* name) {
     if (!(std::isfinite(v) && v > 0.0)) {
@@ -69,6 +75,7 @@ void FusionConfig::validate() const {
   positive(vio_sigma_floor_m, "vio_sigma_floor_m");
   positive(vio_rot_drift_rad_per_m, "vio_rot_drift_rad_per_m");
   positive(vio_rot_floor_rad, "vio_rot_floor_rad");
+  positive(tilt_sigma_deg, "tilt_sigma_deg");
   positive(huber_sigmas, "huber_sigmas");
   positive(gate_chi2, "gate_chi2");
   if (!(std::isfinite(gate_floor_m) && gate_floor_m >= 0.0)) {
@@ -296,7 +303,8 @@ void GnssFusion::Impl::smooth() {
   const auto start = Clock::now();
   const RelativeNoise noise = config.relativeNoise();
   const SmoothedNodes nodes =
-      smoothNodes(graph_fixes, config.lever_arm_b, noise, config.huber_sigmas, config.smoother);
+      smoothNodes(graph_fixes, config.lever_arm_b, noise, config.huber_sigmas, config.smoother,
+                  config.tiltSigmaRad());
   smoothed = spreadOverVio(vio, graph_fixes, nodes, noise, &smoothed_covariance);
   stats.ms_smoothing = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }

@@ -57,7 +57,7 @@ void SmootherConfig::validate() const {
 
 SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Vector3d& lever_arm_b,
                           const RelativeNoise& noise, double huber_sigmas,
-                          const SmootherConfig& config) {
+                          const SmootherConfig& config, double tilt_sigma_rad) {
   const std::size_t n = fixes.size();
   // Every parameter block in one buffer, poses then biases: ceres::Covariance orders the blocks
   // by address, and two separate allocations came in either order from run to run (measured: the
@@ -79,6 +79,10 @@ SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Ve
     const SmootherFix& f = fixes[k];
     odometry::poseToBlock(f.T_enu_b, poses[k]);
     problem.AddParameterBlock(poses[k], odometry::kPoseAmbient, &manifold);
+    if (tilt_sigma_rad > 0.0) {
+      const Eigen::Vector3d g_b = f.T_w_b.rotation().transpose() * Eigen::Vector3d::UnitZ();
+      problem.AddResidualBlock(new TiltFactor(g_b, tilt_sigma_rad), nullptr, poses[k]);
+    }
     if (with_bias) {
       problem.AddResidualBlock(
           new GnssBiasedPositionFactor(lever_arm_b, f.p_enu, f.sigma_h_m, f.sigma_v_m), &loss,

@@ -68,9 +68,10 @@ struct SmoothedNodes {
 };
 
 // The smoothed body pose T_enu_b at each fix. `lever_arm_b`: antenna in the body.
+// `tilt_sigma_rad` > 0 (the VIO has an IMU): a TiltFactor per node keeps the VIO's roll and pitch.
 SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Vector3d& lever_arm_b,
                           const RelativeNoise& noise, double huber_sigmas,
-                          const SmootherConfig& config);
+                          const SmootherConfig& config, double tilt_sigma_rad = 0.0);
 
 // Every VIO pose in ENU: between nodes i and i+1 the two nodes carried by the VIO motion, blended
 // linearly in time (slerp for the rotation); before the first / after the last node, that node
