@@ -30,18 +30,56 @@ Matrix6d sqrtInformation(const Matrix6d& covariance) {
   return Matrix6d(llt.matrixL()).inverse();
 }
 
+bool sameSegment(const std::vector<GraphNode>& nodes, const GraphFix& a, const GraphFix& b) {
+  return nodes[a.node].segment == nodes[b.node].segment;
+}
+
+// The first node of each segment that nothing anchors: a segment is anchored by its own fixes,
+// or by loops (any chain of them) to an anchored segment; without any fix, the first segment is
+// the anchor. Union-find over the segments.
+std::vector<std::size_t> gaugeNodes(const std::vector<GraphNode>& nodes,
+                                    const std::vector<GraphFix>& fixes,
+                                    const std::vector<GraphLoop>& loops) {
+  const std::size_t n = nodes.back().segment + 1;
+  std::vector<std::size_t> parent(n);
+  for (std::size_t s = 0; s < n; ++s) parent[s] = s;
+  const auto root = [&](std::size_t s) {
+    while (parent[s] != s) s = parent[s] = parent[parent[s]];
+    return s;
+  };
+  for (const GraphLoop& l : loops) parent[root(nodes[l.i].segment)] = root(nodes[l.j].segment);
+  std::vector<bool> anchored(n, false);
+  for (const GraphFix& f : fixes) anchored[root(nodes[f.node].segment)] = true;
+  if (fixes.empty()) anchored[root(nodes.front().segment)] = true;
+  std::vector<std::size_t> gauges;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const bool first = k == 0 || nodes[k].segment != nodes[k - 1].segment;
+    if (!first || anchored[root(nodes[k].segment)]) continue;
+    anchored[root(nodes[k].segment)] = true;  // this node anchors its whole component
+    gauges.push_back(k);
+  }
+  if (fixes.empty()) gauges.insert(gauges.begin(), 0);
+  return gauges;
+}
+
 void checkInputs(const std::vector<GraphNode>& nodes, const std::vector<GraphFix>& fixes,
                  const std::vector<GraphLoop>& loops) {
   if (nodes.empty()) throw InvalidInput("global graph: no nodes");
   for (std::size_t k = 1; k < nodes.size(); ++k) {
-    if (nodes[k].t_ns <= nodes[k - 1].t_ns) {
-      throw InvalidInput("global graph: node stamps must increase");
+    if (nodes[k].segment < nodes[k - 1].segment) {
+      throw InvalidInput("global graph: nodes must be grouped by segment in increasing order");
+    }
+    if (nodes[k].segment == nodes[k - 1].segment && nodes[k].t_ns <= nodes[k - 1].t_ns) {
+      throw InvalidInput("global graph: node stamps must increase within a segment");
     }
   }
   for (std::size_t k = 0; k < fixes.size(); ++k) {
     if (fixes[k].node >= nodes.size()) throw InvalidInput("global graph: fix on a missing node");
-    if (k > 0 && fixes[k].t_ns < fixes[k - 1].t_ns) {
+    if (k > 0 && sameSegment(nodes, fixes[k], fixes[k - 1]) && fixes[k].t_ns < fixes[k - 1].t_ns) {
       throw InvalidInput("global graph: fixes must be in time order");
+    }
+    if (k > 0 && nodes[fixes[k].node].segment < nodes[fixes[k - 1].node].segment) {
+      throw InvalidInput("global graph: fixes must be grouped by segment in increasing order");
     }
     if (!(fixes[k].sigma_h_m > 0.0 && fixes[k].sigma_v_m > 0.0)) {
       throw InvalidInput("global graph: fix sigmas must be > 0");
@@ -88,7 +126,9 @@ class Graph {
                                robust ? &cauchy : nullptr, poses_[loops_[k].i].data(),
                                poses_[loops_[k].j].data());
     }
-    if (fixes_.empty()) problem.SetParameterBlockConstant(poses_.front().data());
+    for (std::size_t k : gaugeNodes(nodes_, fixes_, loops_)) {
+      problem.SetParameterBlockConstant(poses_[k].data());
+    }
     const ceres::Solver::Options options = batchSolverOptions(config_.max_iterations);
     ceres::Solver::Summary summary;
     ceres::Solve(options, &problem, &summary);
@@ -114,7 +154,7 @@ class Graph {
         problem.AddResidualBlock(new TiltFactor(g_b, config_.tilt_sigma_rad), nullptr,
                                  poses_[k].data());
       }
-      if (k == 0) continue;
+      if (k == 0 || nodes_[k].segment != nodes_[k - 1].segment) continue;
       const Eigen::Isometry3d T_rel = nodes_[k - 1].T_w_b.inverse() * nodes_[k].T_w_b;
       const double d = T_rel.translation().norm();
       problem.AddResidualBlock(new RelativePoseFactor(T_rel, config_.vio.rotationSigmaRad(d),
@@ -136,8 +176,9 @@ class Graph {
       problem.AddResidualBlock(
           new GnssBiasedPositionFactor(f.q_b, f.p_enu, f.sigma_h_m, f.sigma_v_m), &huber_, pose,
           biases_[k].data());
-      if (k == 0) {
-        // The bias's stationary distribution at the first fix: N(0, sigma^2 I).
+      if (k == 0 || nodes_[f.node].segment != nodes_[fixes_[k - 1].node].segment) {
+        // The bias's stationary distribution at a drive's first fix: N(0, sigma^2 I); each drive
+        // has its own receiver (or its own day).
         const Eigen::Matrix3d A = Eigen::Matrix3d::Identity() / (config_.bias_ratio * f.sigma_h_m);
         problem.AddResidualBlock(new ceres::NormalPrior(A, Eigen::Vector3d::Zero()), nullptr,
                                  biases_[0].data());

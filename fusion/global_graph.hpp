@@ -13,6 +13,9 @@
 // again without robust kernels on the loops, until the active set no longer changes. Each solve
 // runs to Ceres' convergence criteria (not a fixed handful of iterations: VINS-Mono issue 30);
 // the result says whether it converged.
+// Several drives in one graph (gvio merge's joint alignment, issue 18): each node names its
+// segment (drive); VIO factors and the receiver bias's Gauss-Markov chain stay within a segment,
+// and loops between segments are what ties the drives together.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstddef>
@@ -43,6 +46,7 @@ struct GlobalGraphConfig {
 
 struct GraphNode {
   std::int64_t t_ns = 0;
+  std::uint32_t segment = 0;  // the drive; nodes are grouped by segment, in increasing order
   Eigen::Isometry3d T_w_b = Eigen::Isometry3d::Identity();   // the VIO pose (relative factors)
   Eigen::Isometry3d T_init = Eigen::Isometry3d::Identity();  // initial estimate, target frame
 };
@@ -80,9 +84,11 @@ struct GlobalGraphResult {
   double ms_solve = 0.0;             // wall time of all rounds
 };
 
-// Nodes in time order (>= 1). Without fixes the first node is held fixed (the gauge); with fixes
-// they anchor the graph. `has_imu` enables the tilt factors (config.tilt permitting). Loops whose
-// indices are out of range or equal throw InvalidInput.
+// Nodes in time order within each segment (>= 1 node); fixes in time order within each segment,
+// the segments' fixes in segment order. Fixes anchor the graph; a segment that neither has fixes
+// nor is joined by loops to one that has (or to the first segment, when no segment has fixes)
+// holds its first node fixed (its gauge). `has_imu` enables the tilt factors (config.tilt
+// permitting). Loops whose indices are out of range or equal throw InvalidInput.
 GlobalGraphResult solveGlobalGraph(const std::vector<GraphNode>& nodes,
                                    const std::vector<GraphFix>& fixes,
                                    const std::vector<GraphLoop>& loops, bool has_imu,

@@ -29,9 +29,18 @@ double angleDeg(const Eigen::Matrix3d& R) {
 // 1-sigma uncertainty of the prior relative position of two keyframes (see the header).
 double relativeSigmaM(const KeyframePrior& a, const KeyframePrior& b,
                       const fusion::RelativeNoise& drift) {
-  const double by_drift = drift.positionSigmaM(std::abs(b.path_m - a.path_m));
   const double by_gnss = std::hypot(a.sigma_m, b.sigma_m);  // infinite without GNSS
-  return std::min(by_drift, by_gnss);
+  if (a.segment != b.segment) return by_gnss;               // no VIO path joins two drives
+  return std::min(drift.positionSigmaM(std::abs(b.path_m - a.path_m)), by_gnss);
+}
+
+// 1-sigma uncertainty (deg) of their prior relative rotation: the VIO's rotation drift within a
+// drive; between drives the two GNSS-fused rotation uncertainties (the heading of a short or
+// straight drive is known to a few degrees only).
+double relativeSigmaDeg(const KeyframePrior& a, const KeyframePrior& b,
+                        const fusion::RelativeNoise& drift) {
+  if (a.segment != b.segment) return std::hypot(a.sigma_rot_deg, b.sigma_rot_deg);
+  return degrees(drift.rotationSigmaRad(std::abs(b.path_m - a.path_m)));
 }
 
 // A verified loop's correction of the query's prior pose in the target frame (the candidate's
@@ -51,10 +60,11 @@ Correction correctionOf(const KeyframePrior& cand, const KeyframePrior& query,
 class Search {
  public:
   Search(const std::vector<KeyframePrior>& priors, const LoopSearchConfig& config,
-         const fusion::RelativeNoise& drift)
+         const fusion::RelativeNoise& drift, LoopPairs pairs)
       : priors_(priors),
         config_(config),
         drift_(drift),
+        pairs_(pairs),
         cloud_(new pcl::PointCloud<pcl::PointXYZ>) {
     for (const KeyframePrior& p : priors) {
       const Eigen::Vector3d t = p.T_ref_b.translation();
@@ -62,15 +72,20 @@ class Search {
                                       static_cast<float>(t.z())));
     }
     for (const KeyframePrior& p : priors) max_sigma_ = std::max(max_sigma_, p.sigma_m);
+    segments_ = !priors.empty() && priors.front().segment != priors.back().segment;
     if (!priors.empty()) tree_.setInputCloud(cloud_);
   }
 
   // Older keyframes that may show the place query j shows, in index order.
   std::vector<std::size_t> candidates(std::size_t j, LoopDetection& stats) {
     const KeyframePrior& q = priors_[j];
-    const double widest_sigma = std::min(drift_.positionSigmaM(q.path_m - priors_.front().path_m),
-                                         std::hypot(q.sigma_m, max_sigma_));
-    const double radius = config_.search_radius_m + config_.search_sigmas * widest_sigma;
+    const double by_gnss = std::hypot(q.sigma_m, max_sigma_);
+    const double widest_sigma =
+        segments_ ? by_gnss
+                  : std::min(drift_.positionSigmaM(q.path_m - priors_.front().path_m), by_gnss);
+    // Without GNSS between drives nothing bounds the search: every keyframe is a candidate.
+    const double radius =
+        std::min(config_.search_radius_m + config_.search_sigmas * widest_sigma, 1e30);
     std::vector<int> found;
     std::vector<float> sq;
     tree_.radiusSearch((*cloud_)[j], radius, found, sq);
@@ -80,7 +95,11 @@ class Search {
     const Eigen::Vector3d f_q = q.T_ref_b.rotation().col(0);
     for (int idx : found) {
       const auto i = static_cast<std::size_t>(idx);
-      if (i >= j || static_cast<double>(q.t_ns - priors_[i].t_ns) < min_sep_ns) continue;
+      if (i >= j) continue;
+      if (priors_[i].segment == q.segment) {
+        if (pairs_ == LoopPairs::kAcrossSegments) continue;
+        if (static_cast<double>(q.t_ns - priors_[i].t_ns) < min_sep_ns) continue;
+      }
       if (distance(i, j) > radiusFor(i, j)) continue;
       ++stats.pairs_in_radius;
       const double cos_heading = f_q.dot(priors_[i].T_ref_b.rotation().col(0));
@@ -106,7 +125,7 @@ class Search {
     const KeyframePrior& a = priors_[c.candidate];
     const KeyframePrior& b = priors_[c.query];
     const double sigma_m = relativeSigmaM(a, b, drift_);
-    const double sigma_deg = degrees(drift_.rotationSigmaRad(std::abs(b.path_m - a.path_m)));
+    const double sigma_deg = relativeSigmaDeg(a, b, drift_);
     return c.correction_m <= config_.search_sigmas * sigma_m + config_.correction_floor_m &&
            c.correction_deg <= config_.search_sigmas * sigma_deg + config_.correction_floor_deg;
   }
@@ -115,6 +134,8 @@ class Search {
   const std::vector<KeyframePrior>& priors_;
   const LoopSearchConfig& config_;
   const fusion::RelativeNoise& drift_;
+  LoopPairs pairs_;
+  bool segments_ = false;  // keyframes of more than one drive
   pcl::PointCloud<pcl::PointXYZ>::Ptr cloud_;
   pcl::KdTreeFLANN<pcl::PointXYZ> tree_;
   double max_sigma_ = 0.0;
@@ -188,14 +209,20 @@ void LoopConfig::validate() const {
 
 LoopDetection detectLoops(const std::vector<LoopKeyframe>& keyframes,
                           const std::vector<KeyframePrior>& priors, const CameraModel& camera,
-                          const LoopConfig& config, const fusion::RelativeNoise& drift) {
+                          const LoopConfig& config, const fusion::RelativeNoise& drift,
+                          LoopPairs pairs) {
   config.validate();
   if (keyframes.size() != priors.size()) {
     throw InvalidInput("loop detection: keyframes and priors differ in number");
   }
   LoopDetection out;
   if (priors.empty()) return out;
-  Search search(priors, config.search, drift);
+  for (std::size_t k = 1; k < priors.size(); ++k) {
+    if (priors[k].segment < priors[k - 1].segment) {
+      throw InvalidInput("loop detection: keyframes must be grouped by segment");
+    }
+  }
+  Search search(priors, config.search, drift, pairs);
   std::vector<std::optional<Correction>> corrections;
   std::vector<std::size_t> best;  // per query with a plausible loop: its best candidate
   for (std::size_t j = 0; j < keyframes.size(); ++j) {

@@ -19,6 +19,7 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -59,9 +60,16 @@ struct LoopConfig {
 // What the run knows of a keyframe before loop closure.
 struct KeyframePrior {
   std::int64_t t_ns = 0;
+  // The drive (gvio merge's joint alignment); keyframes are grouped by segment. Between two
+  // segments there is no time or path relation: neither the time separation nor the VIO drift
+  // bound applies, only the GNSS-fused uncertainty.
+  std::uint32_t segment = 0;
   Eigen::Isometry3d T_ref_b = Eigen::Isometry3d::Identity();  // pose in the run's target frame
   // 1-sigma absolute position uncertainty (GNSS-fused); infinity without GNSS.
   double sigma_m = 0.0;
+  // 1-sigma rotation uncertainty (deg) of the GNSS-fused pose (its covariance's largest rotation
+  // eigenvalue); infinity without GNSS. Bounds the heading correction of a loop between drives.
+  double sigma_rot_deg = std::numeric_limits<double>::infinity();
   double path_m = 0.0;  // distance driven from the first keyframe
 };
 
@@ -83,11 +91,17 @@ struct LoopDetection {
   std::size_t pairs_in_radius = 0, pairs_heading_ok = 0;
 };
 
-// `keyframes` and `priors` are parallel, in time order. `camera` is the rectified left camera
-// (T_b_c). `drift` is the VIO's relative-motion noise model.
+// Which keyframe pairs are searched: all of them (one drive), or only pairs of different segments
+// (gvio merge: each drive closed its own loops in its run).
+enum class LoopPairs { kAll, kAcrossSegments };
+
+// `keyframes` and `priors` are parallel, in time order within each segment. `camera` is the
+// rectified left camera (T_b_c) of every keyframe. `drift` is the VIO's relative-motion noise
+// model.
 LoopDetection detectLoops(const std::vector<LoopKeyframe>& keyframes,
                           const std::vector<KeyframePrior>& priors, const CameraModel& camera,
-                          const LoopConfig& config, const fusion::RelativeNoise& drift);
+                          const LoopConfig& config, const fusion::RelativeNoise& drift,
+                          LoopPairs pairs = LoopPairs::kAll);
 
 // The accepted loops as global-graph factors (node = keyframe index), their covariance with the
 // config's floors added; `index_out` gets each one's position in detection.candidates.

@@ -3,6 +3,8 @@
 // fixes with a receiver bias, and bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <iostream>
 #include <numbers>
@@ -234,6 +236,96 @@ TEST(GlobalGraph, FixesWithABiasAndLoopsMakeTheLapsAgree) {
   EXPECT_LT(lapError(with.T), 0.1);
   EXPECT_LT(lapError(with.T), 0.3 * lapError(without.T));
   EXPECT_TRUE(with.converged);
+}
+
+// Two drives of the circle (segments 0 and 1: the first lap, then the second as a drive of its
+// own, in a VIO world of its own), each with its own receiver bias: loops between them make the
+// drives agree; without loops each keeps its own GNSS error. No VIO factor joins the segments.
+struct TwoDrives {
+  std::vector<GraphNode> nodes;
+  std::vector<GraphFix> fixes;
+  std::vector<GraphLoop> loops;
+  std::vector<Eigen::Isometry3d> truth;
+};
+
+TwoDrives makeTwoDrives(const LoopWorld& w) {
+  TwoDrives d;
+  d.truth = w.truth;
+  d.loops = w.loops;  // i on the first lap (drive 0), j on the second (drive 1)
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  Eigen::Isometry3d other_world = Eigen::Isometry3d::Identity();
+  other_world.linear() = Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  other_world.translation() = Eigen::Vector3d(300.0, -40.0, 2.0);
+  const std::array<Eigen::Vector3d, 2> bias = {Eigen::Vector3d(0.9, -0.6, 0.3),
+                                               Eigen::Vector3d(-0.7, 0.8, -0.2)};
+  for (std::size_t k = 0; k < w.nodes.size(); ++k) {
+    GraphNode n = w.nodes[k];
+    n.segment = k > w.per_lap ? 1 : 0;
+    if (n.segment == 1) n.T_w_b = other_world * n.T_w_b;
+    // Each drive's own registration: placed at its biased fixes.
+    n.T_init = w.truth[k];
+    n.T_init.translation() += bias[n.segment];
+    d.nodes.push_back(n);
+  }
+  for (std::size_t k = 0; k < d.nodes.size(); k += 5) {
+    GraphFix f;
+    f.node = k;
+    f.t_ns = d.nodes[k].t_ns;
+    f.p_enu = w.truth[k].translation() + bias[d.nodes[k].segment] +
+              0.3 * Eigen::Vector3d(n01(rng), n01(rng), 0.0);
+    f.sigma_h_m = 1.5;
+    f.sigma_v_m = 3.0;
+    d.fixes.push_back(f);
+  }
+  return d;
+}
+
+TEST(GlobalGraph, LoopsBetweenDrivesMakeTwoDrivesAgree) {
+  const TwoDrives d = makeTwoDrives(makeLoopWorld());
+  const auto disagreement = [&](const std::vector<Eigen::Isometry3d>& T) {
+    double sum = 0.0;
+    for (const GraphLoop& l : d.loops) {
+      const Eigen::Vector3d est = T[l.j].translation() - T[l.i].translation();
+      const Eigen::Vector3d ref = d.truth[l.j].translation() - d.truth[l.i].translation();
+      sum += (est - ref).squaredNorm();
+    }
+    return std::sqrt(sum / static_cast<double>(d.loops.size()));
+  };
+  const GlobalGraphResult apart = solveGlobalGraph(d.nodes, d.fixes, {}, true, graphConfig());
+  const GlobalGraphResult joint = solveGlobalGraph(d.nodes, d.fixes, d.loops, true, graphConfig());
+  std::cout << "two drives: disagreement " << disagreement(apart.T) << " m apart, "
+            << disagreement(joint.T) << " m joint (" << joint.rounds << " rounds); rmse "
+            << rmse(d.truth, apart.T) << " m apart, " << rmse(d.truth, joint.T) << " m joint\n";
+  EXPECT_GT(disagreement(apart.T), 1.0);  // the two receivers' biases differ by ~2 m
+  EXPECT_LT(disagreement(joint.T), 0.1);
+  EXPECT_TRUE(joint.converged) << joint.termination;
+  for (const LoopVerdict& v : joint.loops) EXPECT_TRUE(v.active) << v.chi2;
+  EXPECT_LT(rmse(d.truth, joint.T), rmse(d.truth, apart.T));
+  // No VIO factor across the segments: drive 1's own VIO world (300 m away, turned 57 deg) would
+  // otherwise pull the drives apart, as it does when they are declared one segment.
+  std::vector<GraphNode> one = d.nodes;
+  for (GraphNode& n : one) n.segment = 0;
+  const GlobalGraphResult mixed = solveGlobalGraph(one, d.fixes, d.loops, true, graphConfig());
+  std::cout << "as one segment: rmse " << rmse(d.truth, mixed.T) << " m\n";
+  EXPECT_GT(rmse(d.truth, mixed.T), 3.0 * rmse(d.truth, joint.T));
+}
+
+TEST(GlobalGraph, ASegmentWithoutFixesOrLoopsHoldsItsFirstNode) {
+  TwoDrives d = makeTwoDrives(makeLoopWorld());
+  std::erase_if(d.fixes, [&](const GraphFix& f) { return d.nodes[f.node].segment == 1; });
+  const GlobalGraphResult r = solveGlobalGraph(d.nodes, d.fixes, {}, true, graphConfig());
+  const std::size_t first1 = static_cast<std::size_t>(
+      std::find_if(d.nodes.begin(), d.nodes.end(), [](const GraphNode& n) { return n.segment; }) -
+      d.nodes.begin());
+  EXPECT_LT((r.T[first1].translation() - d.nodes[first1].T_init.translation()).norm(), 1e-9);
+  EXPECT_TRUE(r.converged) << r.termination;
+  // Joined by loops to the anchored drive, it is free and follows the loops.
+  const GlobalGraphResult joined = solveGlobalGraph(d.nodes, d.fixes, d.loops, true, graphConfig());
+  EXPECT_GT((joined.T[first1].translation() - d.nodes[first1].T_init.translation()).norm(), 0.5);
+  // Segments out of order are refused.
+  std::swap(d.nodes.front().segment, d.nodes.back().segment);
+  EXPECT_THROW(solveGlobalGraph(d.nodes, d.fixes, {}, true, graphConfig()), InvalidInput);
 }
 
 TEST(GlobalGraph, BadInputThrows) {

@@ -193,6 +193,35 @@ TEST(LoopDetection, RepeatedTextureGivesNoFalseLoop) {
   EXPECT_EQ(falseLoops(d, det), 0);
 }
 
+// Two drives over the same 200 m of road at the same clock times (gvio merge's case), each with a
+// GNSS error of its own: across segments the loops are found without any time separation, only
+// between the drives, and none is wrong.
+TEST(LoopDetection, AcrossSegmentsFindsTheOtherDriveOnly) {
+  const std::vector<WorldPoint> world = makeWorld(false, 4);
+  Drive both = makeDrive(world, 200.0 / (2.0 * std::numbers::pi * kRadius), true);
+  const std::size_t n = both.keyframes.size();
+  const Drive second = makeDrive(world, 200.0 / (2.0 * std::numbers::pi * kRadius), true);
+  for (std::size_t k = 0; k < n; ++k) {
+    KeyframePrior p = second.priors[k];
+    p.segment = 1;
+    p.T_ref_b.translation() += Eigen::Vector3d(-1.2, 0.9, 0.0);  // another receiver's error
+    both.priors.push_back(p);
+    both.keyframes.push_back(second.keyframes[k]);
+    both.truth.push_back(second.truth[k]);
+  }
+  const LoopDetection det = detectLoops(both.keyframes, both.priors, camera(), LoopConfig{}, kDrift,
+                                        LoopPairs::kAcrossSegments);
+  EXPECT_GT(accepted(det), 100);  // ~200 keyframes of drive 1 see drive 0's places
+  EXPECT_EQ(falseLoops(both, det), 0);
+  for (const LoopCandidate& c : det.candidates) {
+    EXPECT_LT(c.candidate, n);
+    EXPECT_GE(c.query, n);
+  }
+  EXPECT_THROW(detectLoops(both.keyframes, {both.priors.rbegin(), both.priors.rend()}, camera(),
+                           LoopConfig{}, kDrift, LoopPairs::kAcrossSegments),
+               InvalidInput);  // not grouped by segment
+}
+
 TEST(LoopDetection, BadConfigThrows) {
   LoopConfig c;
   c.search.max_heading_deg = 0.0;
