@@ -16,7 +16,10 @@ int runMergeCommand(const MergeCliOptions& o) {
   fleet::MergeRequest request;
   for (const auto& r : o.runs) request.runs.emplace_back(r);
   request.out_dir = o.out;
-  request.config = o.config.load().merge;
+  const auto config = o.config.load();
+  request.config = config.merge;
+  request.loops = config.loops;
+  request.fusion = config.fusion.fusion;
   if (o.tile_size_m) request.config.tile_size_m = *o.tile_size_m;
   fleet::runMerge(request);
   return 0;

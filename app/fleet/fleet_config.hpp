@@ -25,6 +25,9 @@ struct FleetConfig {
 };
 
 struct MergeConfig {
+  // Bring overlapping drives into agreement first (merge_align.hpp): loops between the drives
+  // and one joint pose graph; the drives' maps follow their keyframes.
+  bool align = true;
   double tile_size_m = 50.0;            // square UTM tiles (gvio merge --tile-size overrides it)
   double octomap_resolution_m = 0.2;    // leaf size of each tile's .bt
   double max_zone_distance_km = 100.0;  // a run farther than this outside the first run's UTM zone

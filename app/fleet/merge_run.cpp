@@ -8,7 +8,9 @@
 #include <chrono>
 #include <set>
 
+#include "fleet/merge_align.hpp"
 #include "fusion/enu_utm_grid.hpp"
+#include "io/atomic_write.hpp"
 #include "io/input_error.hpp"
 #include "io/run_dir.hpp"
 #include "run/stats.hpp"
@@ -18,14 +20,17 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A run's map.pcd into the spill, in the merge's UTM zone.
-std::uint64_t spillRun(const MergeRun& run, const MergeFrame& frame, TileSpill& spill) {
+// A run's map.pcd into the spill, in the merge's UTM zone, carried onto the joint alignment's
+// poses when it moved.
+std::uint64_t spillRun(const MergeRun& run, const MergeFrame& frame, TileSpill& spill,
+                       mapping::MapCorrection* correction) {
   const io::MapCloud cloud = io::readMapCloud(run.dir / "map.pcd");
   fusion::EnuToUtmGrid grid(run.georef.enu_origin, frame.crs.zone, frame.crs.north);
   std::uint64_t added = 0;
   for (std::size_t k = 0; k < cloud.p_enu.size(); ++k) {
-    const Eigen::Vector3d p_enu = cloud.p_enu[k].cast<double>();
+    Eigen::Vector3d p_enu = cloud.p_enu[k].cast<double>();
     if (!p_enu.allFinite()) continue;
+    if (correction != nullptr) p_enu = correction->apply(p_enu);
     const float intensity = cloud.intensity.empty() ? 0.0F : cloud.intensity[k];
     const auto las_intensity =
         static_cast<std::uint16_t>(std::clamp(intensity, 0.0F, 255.0F) * 257.0F);
@@ -34,6 +39,28 @@ std::uint64_t spillRun(const MergeRun& run, const MergeFrame& frame, TileSpill& 
     ++added;
   }
   return added;
+}
+
+void logAlignment(const std::vector<MergeRun>& runs, const MergeAlignment& a) {
+  if (!a.attempted) return;
+  spdlog::info(
+      "merge: alignment: {} pair(s) of keyframes of different drives within reach, {} verified, "
+      "{} accepted, {} kept by the joint graph{}",
+      a.pairs_in_radius, a.verified, a.accepted, a.active,
+      a.solved ? fmt::format(" ({} rounds, {:.0f} ms, {})", a.graph.rounds, a.graph.ms_solve,
+                             a.graph.converged ? "converged" : "NOT converged")
+               : "");
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    const DriveMovement& m = a.drives[r];
+    if (!m.aligned) {
+      spdlog::info("merge: alignment: {}: not moved ({})", runs[r].name, m.note);
+      continue;
+    }
+    spdlog::info(
+        "merge: alignment: {}: {} loop(s) to other drives; moved {:.3f} m on average, "
+        "{:.3f} m at most, turned {:.3f} deg at most",
+        runs[r].name, m.loops_active, m.moved_mean_m, m.moved_max_m, m.rotated_max_deg);
+  }
 }
 
 // Tiles of an earlier merge into this folder that this one did not write.
@@ -60,12 +87,26 @@ MergeSummary runMerge(const MergeRequest& request) {
   fs::create_directories(tiles_dir, ec);
   if (ec) throw io::InputError(request.out_dir, 0, "cannot create the folder: " + ec.message());
 
+  MergeAlignment alignment;
+  if (request.config.align) {
+    alignment = alignDrives(runs, request.loops, request.fusion);
+    io::writeTextAtomic(request.out_dir / "alignment.json",
+                        alignmentJson(runs, alignment).dump(2) + "\n");
+    io::writeTextAtomic(request.out_dir / "alignment_loops.csv", alignment.csv);
+    logAlignment(runs, alignment);
+  }
   MergeSummary summary;
   summary.tile_size_m = request.config.tile_size_m;
   TileSpill spill(request.out_dir / fmt::format(".merge-scratch-{}", ::getpid()),
                   request.config.tile_size_m, frame.origin_utm.z());
-  for (const MergeRun& run : runs) {
-    const std::uint64_t n = spillRun(run, frame, spill);
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    const MergeRun& run = runs[r];
+    mapping::MapCorrection* correction = nullptr;
+    if (r < alignment.corrections.size() && alignment.corrections[r]) {
+      correction = &*alignment.corrections[r];
+    }
+    const std::uint64_t n = spillRun(run, frame, spill, correction);
+    if (correction != nullptr) alignment.corrections[r].reset();  // its cell cache is done
     summary.points_per_drive[run.point_source_id] = n;
     summary.points += n;
     spdlog::info("merge: {} ({} points, point source ID {})", run.name, n, run.point_source_id);

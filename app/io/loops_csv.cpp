@@ -80,22 +80,30 @@ LoopCsvRow parseRow(const std::vector<std::string_view>& f, const LineReader& in
 
 }  // namespace
 
+std::string loopsCsvLine(const LoopCsvRow& r) {
+  if (r.matches < 0 || r.inliers < 0 || !isReasonToken(r.reason) ||
+      r.accepted != (r.reason == "ok")) {
+    throw std::invalid_argument(
+        fmt::format("loop {} -> {}: negative count or reason '{}' not valid for its verdict",
+                    formatSeconds(r.query_t_ns), formatSeconds(r.candidate_t_ns), r.reason));
+  }
+  return fmt::format("{},{},{},{},{},{},{},{},{},{},{}", formatSeconds(r.query_t_ns),
+                     formatSeconds(r.candidate_t_ns), formatQuantity(r.distance_m),
+                     formatQuantity(r.search_radius_m), r.matches, r.inliers,
+                     formatQuantity(r.reprojection_px), formatQuantity(r.correction_m),
+                     formatQuantity(r.correction_deg), r.accepted ? "accepted" : "rejected",
+                     r.reason);
+}
+
 void writeLoopsCsv(const std::filesystem::path& file, const std::vector<LoopCsvRow>& rows) {
   std::string text(kLoopsCsvHeader);
   text += '\n';
   for (const LoopCsvRow& r : rows) {
-    if (r.matches < 0 || r.inliers < 0 || !isReasonToken(r.reason) ||
-        r.accepted != (r.reason == "ok")) {
-      throw std::invalid_argument(fmt::format(
-          "{}: loop {} -> {}: negative count or reason '{}' not valid for its verdict",
-          file.string(), formatSeconds(r.query_t_ns), formatSeconds(r.candidate_t_ns), r.reason));
+    try {
+      text += loopsCsvLine(r) + '\n';
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(file.string() + ": " + e.what());
     }
-    text += fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", formatSeconds(r.query_t_ns),
-                        formatSeconds(r.candidate_t_ns), formatQuantity(r.distance_m),
-                        formatQuantity(r.search_radius_m), r.matches, r.inliers,
-                        formatQuantity(r.reprojection_px), formatQuantity(r.correction_m),
-                        formatQuantity(r.correction_deg), r.accepted ? "accepted" : "rejected",
-                        r.reason);
   }
   writeTextAtomic(file, text);
 }

@@ -37,6 +37,8 @@ inline constexpr std::string_view kLoopsCsvHeader =
 // (not measured). Throws std::invalid_argument for a row the reader would reject (negative
 // count, reason not a [a-z_]+ token or not "ok" exactly when accepted): a bug in the caller.
 void writeLoopsCsv(const std::filesystem::path& file, const std::vector<LoopCsvRow>& rows);
+// One row as writeLoopsCsv writes it (no newline), for files that add columns before it.
+std::string loopsCsvLine(const LoopCsvRow& row);
 
 // Reads the file strictly: the exact header, 11 fields per row, numbers (or "nan" for the
 // quantities), counts >= 0, verdict accepted|rejected, reason "ok" exactly when accepted and a

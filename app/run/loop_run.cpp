@@ -21,10 +21,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-// The 1-sigma position uncertainty of a pose: the square root of its position covariance's
-// largest eigenvalue (the radius that covers every direction).
-double positionSigma(const fusion::PoseCovariance& cov) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov.bottomRightCorner<3, 3>());
+// The 1-sigma uncertainty of a 3x3 block: the square root of its largest eigenvalue (the radius
+// that covers every direction).
+double largestSigma(const Eigen::Matrix3d& block) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(block);
   return std::sqrt(std::max(es.eigenvalues().maxCoeff(), 0.0));
 }
 
@@ -51,7 +51,9 @@ std::vector<mapping::KeyframePrior> keyframePriors(const LoopRecorder& recorder,
     if (it == gnss->fused.t_ns.end() || *it != p.t_ns) continue;
     const auto i = static_cast<std::size_t>(it - gnss->fused.t_ns.begin());
     p.T_ref_b = gnss->fused.poses[i];
-    p.sigma_m = positionSigma(gnss->fused_covariance[i]);
+    p.sigma_m = largestSigma(gnss->fused_covariance[i].bottomRightCorner<3, 3>());
+    p.sigma_rot_deg =
+        largestSigma(gnss->fused_covariance[i].topLeftCorner<3, 3>()) * 180.0 / std::numbers::pi;
   }
   // A keyframe without a fused pose would mix frames: then every prior stays in the VIO world.
   if (fused && std::any_of(priors.begin(), priors.end(),
@@ -59,6 +61,7 @@ std::vector<mapping::KeyframePrior> keyframePriors(const LoopRecorder& recorder,
     for (std::size_t k = 0; k < priors.size(); ++k) {
       priors[k].T_ref_b = T_w_b[k];
       priors[k].sigma_m = kInfinity;
+      priors[k].sigma_rot_deg = kInfinity;
     }
   }
   return priors;
@@ -251,6 +254,32 @@ LoopRunResult closeLoops(const LoopRecorder& recorder, const Trajectory& vio,
   solved.T_enu_b = r.graph.T;
   r.trajectory = fusion::spreadOverVio(vio, spread_nodes, solved);
   return r;
+}
+
+std::optional<mapping::PlaceDatabase> placeDatabase(LoopRecorder& recorder, const Trajectory& vio,
+                                                    const Trajectory& final_enu,
+                                                    const GnssRunResult& gnss,
+                                                    const LoopRunResult* loops, bool has_imu,
+                                                    const LoopStageConfig& config,
+                                                    const fusion::FusionConfig& fusion) {
+  if (!gnss.T_enu_w || gnss.fused.empty() || recorder.empty() || vio.empty()) return std::nullopt;
+  mapping::PlaceDatabase db;
+  db.camera = recorder.camera();
+  db.has_imu = has_imu;
+  db.priors = keyframePriors(recorder, &gnss);
+  db.T_vio = recorder.vioPoses();
+  for (mapping::KeyframePrior& p : db.priors) {
+    const auto T = fusion::interpolatePose(final_enu, p.t_ns);
+    if (!T) return std::nullopt;  // a keyframe outside the final trajectory: not the map's poses
+    p.T_ref_b = *T;
+  }
+  db.fixes = graphFixes(graphNodes(recorder, &gnss), vio, gnss, fusion.lever_arm_b);
+  if (loops != nullptr) {
+    std::vector<std::size_t> index;
+    db.loops = mapping::acceptedGraphLoops(loops->detection, config.detection, index);
+  }
+  db.keyframes = recorder.takeKeyframes();
+  return db;
 }
 
 nlohmann::json loopsReport(const LoopRunResult& r) {

@@ -20,6 +20,7 @@
 #include "fusion/global_graph.hpp"
 #include "io/loops_csv.hpp"
 #include "mapping/loop_closure.hpp"
+#include "mapping/place_database.hpp"
 #include "odometry/trajectory.hpp"
 #include "run/gnss_run.hpp"
 #include "run/vio_runner.hpp"
@@ -37,7 +38,8 @@ struct LoopStageConfig {
   // The VIO's own tilt error reaches ~1 deg in its initialisation transients (simulated drives):
   // a stiffer tilt prior would fight correct loops there.
   double graph_tilt_sigma_deg = 1.0;
-  void validate() const;  // throws InvalidInput naming the key
+  bool save_keyframes = true;  // keyframes.bin (the place database) in a georeferenced run
+  void validate() const;       // throws InvalidInput naming the key
   [[nodiscard]] fusion::GlobalGraphConfig graphConfig(const fusion::FusionConfig& fusion) const;
 };
 
@@ -55,6 +57,7 @@ class LoopRecorder {
   [[nodiscard]] const std::vector<double>& msFeatures() const { return ms_features_; }
   [[nodiscard]] std::size_t memoryBytes() const;
   void release();  // frees the features (after closeLoops)
+  std::vector<mapping::LoopKeyframe> takeKeyframes() { return std::move(keyframes_); }
 
  private:
   mapping::LoopFeatureConfig config_;
@@ -84,6 +87,18 @@ struct LoopRunResult {
 LoopRunResult closeLoops(const LoopRecorder& recorder, const Trajectory& vio,
                          const GnssRunResult* gnss, bool has_imu, const LoopStageConfig& config,
                          const fusion::FusionConfig& fusion);
+
+// The run's place database (keyframes.bin, for gvio merge's joint alignment) of a georeferenced
+// run: the recorder's features, `final_enu` at each keyframe (the poses the map was built with),
+// the fusion's covariances (before the loops) and used fixes, and the loops the run's global graph
+// kept (`loops`, null when loop closure failed). Empty when gnss did not register the VIO. The
+// recorder's features are moved into it (no second copy at the run's peak).
+std::optional<mapping::PlaceDatabase> placeDatabase(LoopRecorder& recorder, const Trajectory& vio,
+                                                    const Trajectory& final_enu,
+                                                    const GnssRunResult& gnss,
+                                                    const LoopRunResult* loops, bool has_imu,
+                                                    const LoopStageConfig& config,
+                                                    const fusion::FusionConfig& fusion);
 
 // report.json's "loops".
 nlohmann::json loopsReport(const LoopRunResult& result);

@@ -5,6 +5,7 @@
 
 #include "io/atomic_write.hpp"
 #include "io/loops_csv.hpp"
+#include "io/place_database_io.hpp"
 #include "io/trajectory_io.hpp"
 #include "run/run_status.hpp"
 
@@ -109,6 +110,13 @@ void runLoopStage(RunState& s) {
     // A bug or an odd drive inside loop closure must not cost the user the run.
     spdlog::warn("loop closure failed ({}): the run goes on without it", e.what());
     s.loops_report = {{"error", e.what()}};
+  }
+  if (s.config.loops.save_keyframes && s.loops && s.gnss) {
+    const Trajectory& final_enu = s.loops->trajectory.empty() ? s.gnss->fused : s.loops->trajectory;
+    const auto db =
+        placeDatabase(*s.loop_recorder, s.vio.trajectory, final_enu, *s.gnss, &*s.loops,
+                      odometry::usesImu(s.estimator.mode), s.config.loops, s.config.fusion.fusion);
+    if (db) io::writePlaceDatabase(s.request.out / "keyframes.bin", *db);
   }
   s.loop_recorder.reset();  // the features are no longer needed: free them before the map
   if (!s.loops) return;

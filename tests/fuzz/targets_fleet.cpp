@@ -1,6 +1,6 @@
 // Fuzz targets of the fleet's inputs (issue 18): the drive list of `gvio fleet`, the plan a
-// Slurm array task reads (`gvio fleet-task`), and a merged map's tiles.json (`gvio render --run
-// MAP`, with one tile beside it).
+// Slurm array task reads (`gvio fleet-task`), a merged map's tiles.json (`gvio render --run
+// MAP`, with one tile beside it) and a run's keyframes.bin (gvio merge's joint alignment).
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -11,6 +11,7 @@
 #include "fleet/merged_map.hpp"
 #include "fuzz/harness.hpp"
 #include "fuzz/targets_list.hpp"
+#include "io/place_database_io.hpp"
 #include "io/run_dir.hpp"
 #include "support/fixtures.hpp"
 
@@ -55,6 +56,43 @@ constexpr const char* kTilePcd =
     "COUNT 1 1 1 1 1 1\nWIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n"
     "1 2 0.5 100 1 1\n-3 4 0.25 50 1 0\n";
 
+// Two keyframes of three keypoints (two with 3-D points), a fix and a loop.
+void writeKeyframesBin(const fs::path& file) {
+  mapping::PlaceDatabase db;
+  db.has_imu = true;
+  db.camera.width_px = 64;
+  db.camera.height_px = 32;
+  db.camera.fx = db.camera.fy = 50.0;
+  db.camera.cx = 32.0;
+  db.camera.cy = 16.0;
+  for (int k = 0; k < 2; ++k) {
+    mapping::LoopKeyframe kf;
+    kf.t_ns = 1'000'000'000LL * (k + 1);
+    kf.px = {{10.0F, 5.0F}, {20.0F, 8.0F}, {40.0F, 20.0F}};
+    kf.descriptors = cv::Mat(3, 32, CV_8U, cv::Scalar(17 + k));
+    kf.p_c = {{0.5F, 0.2F, 8.0F}, {-1.0F, 0.4F, 12.0F}};
+    kf.points = 2;
+    db.keyframes.push_back(kf);
+    mapping::KeyframePrior p;
+    p.t_ns = kf.t_ns;
+    p.T_ref_b.translation() = Eigen::Vector3d(5.0 * k, 0.0, 0.0);
+    p.sigma_m = 1.0;
+    p.path_m = 5.0 * k;
+    db.priors.push_back(p);
+    db.T_vio.push_back(p.T_ref_b);
+  }
+  fusion::GraphFix f;
+  f.node = 1;
+  f.t_ns = 2'000'000'000;
+  f.p_enu = Eigen::Vector3d(5.0, 0.1, 0.8);
+  db.fixes.push_back(f);
+  fusion::GraphLoop l;
+  l.i = 0;
+  l.j = 1;
+  db.loops.push_back(l);
+  io::writePlaceDatabase(file, db);
+}
+
 }  // namespace
 
 void addFleetTargets(std::vector<Target>& out) {
@@ -83,6 +121,23 @@ void addFleetTargets(std::vector<Target>& out) {
     test::writeText(d / "tiles" / "E455350_N5425650.pcd", kTilePcd);
   };
   out.push_back(std::move(tiles));
+  out.push_back(Target{
+      "keyframes_bin", "keyframes.bin",
+      [](const fs::path& d) { writeKeyframesBin(d / "keyframes.bin"); },
+      [](const fs::path& d) {
+        const mapping::PlaceDatabase db = io::readPlaceDatabase(d / "keyframes.bin");
+        require(db.priors.size() == db.keyframes.size() && db.T_vio.size() == db.keyframes.size(),
+                "keyframe records out of step");
+        for (const auto& kf : db.keyframes) {
+          require(kf.points == kf.p_c.size() && kf.points <= kf.px.size() &&
+                      kf.descriptors.rows == static_cast<int>(kf.px.size()),
+                  "keyframe counts disagree");
+        }
+        for (const auto& f : db.fixes) {
+          require(f.node < db.keyframes.size(), "fix off the keyframes");
+        }
+      },
+      ""});
 }
 
 }  // namespace gvio::fuzz
