@@ -6,8 +6,9 @@
 # how far each drive moved (alignment.json). A benchmark, not a test: nothing asserts.
 #
 # Drives: BENCH_SECONDS (default 60) of KITTI-00 ground truth from BENCH_START s (default 0) when
-# ../shared/data has it, else of the embedded assets/demo/drive.tum (35 s). Work folder:
-# BENCH_OUT (default build/bench_merge_align; simulations are kept and reused).
+# ../shared/data has it, else of the embedded assets/demo/drive.tum (35 s); GNSS error model
+# BENCH_GNSS (default spp; rtk shows the floor that the dense stereo points' own noise leaves).
+# Work folder: BENCH_OUT (default build/bench_merge_align[_GNSS]; simulations are kept and reused).
 #
 #   tests/bench/merge_align.sh
 #   BENCH_START=150 BENCH_SECONDS=60 tests/bench/merge_align.sh
@@ -18,7 +19,8 @@ GVIO="$(pwd)/$BUILD_DIR/app/gvio"
 DATA="${GVIO_SHARED_DATA:-../shared/data}/kitti00"
 DRIVE_S="${BENCH_SECONDS:-60}"
 START_S="${BENCH_START:-0}"
-OUT="${BENCH_OUT:-$BUILD_DIR/bench_merge_align}"
+GNSS="${BENCH_GNSS:-spp}"
+OUT="${BENCH_OUT:-$BUILD_DIR/bench_merge_align$([ "$GNSS" = spp ] || echo "_$GNSS")}"
 WORLD_SEED="${BENCH_WORLD_SEED:-7}"
 [ -x "$GVIO" ] || { echo "bench: build gvio first ($GVIO)" >&2; exit 2; }
 mkdir -p "$OUT"
@@ -48,7 +50,7 @@ for seed in 1 2; do
   sim="$OUT/sim$seed"
   if [ ! -f "$sim/sim.yaml" ]; then
     "$GVIO" simulate "${traj[@]}" --seconds "$DRIVE_S" --seed "$seed" --world-seed "$WORLD_SEED" \
-      --gnss-noise spp --out "$sim" --force --no-progress > "$OUT/simulate$seed.log" 2>&1
+      --gnss-noise "$GNSS" --out "$sim" --force --no-progress > "$OUT/simulate$seed.log" 2>&1
   fi
   "$GVIO" run --dataset "$sim" --out "$OUT/run$seed" --gnss graph --no-progress "${geo[@]}" \
     > "$OUT/run$seed.log" 2>&1
@@ -58,15 +60,15 @@ done
 /usr/bin/time -f "%e %M" -o "$OUT/merge_joint.time" \
   "$GVIO" merge --runs "$OUT/run1" "$OUT/run2" --out "$OUT/joint" > "$OUT/merge_joint.log" 2>&1
 
-python3 - "$OUT" "$route" "$DRIVE_S" <<'PY'
+python3 - "$OUT" "$route" "$DRIVE_S" "$GNSS" <<'PY'
 import json, sys
-out, route, seconds = sys.argv[1], sys.argv[2], sys.argv[3]
+out, route, seconds, gnss = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4].upper()
 def agreement(folder):
     a = json.load(open(f"{out}/{folder}/tiles.json"))["drives"][1].get("agreement", {})
     return a.get("within_percent", float("nan")), a.get("median_m", float("nan")), a.get("overlap_points", 0)
 align = json.load(open(f"{out}/joint/alignment.json"))
 wall, rss_kb = open(f"{out}/merge_joint.time").read().split()
-print(f"two drives, {route}, {seconds} s, seeds 1 and 2, one world, SPP GNSS, graph fusion")
+print(f"two drives, {route}, {seconds} s, seeds 1 and 2, one world, {gnss} GNSS, graph fusion")
 print("| merge | within 0.2 m | median | overlap points (sample) |")
 print("| --- | --- | --- | --- |")
 for name, folder in (("without alignment", "apart"), ("joint alignment", "joint")):
