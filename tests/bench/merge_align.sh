@@ -28,18 +28,9 @@ mkdir -p "$OUT"
 traj=(--trajectory assets/demo/drive.tum)
 route="assets/demo/drive.tum"
 if [ -f "$DATA/KITTI_00_gt.txt" ] && [ -f "$DATA/KITTI_00_gt_times.txt" ]; then
-  python3 - "$DATA/KITTI_00_gt.txt" "$DATA/KITTI_00_gt_times.txt" "$START_S" "$OUT" <<'PY'
-import os, sys
-poses = open(sys.argv[1]).read().splitlines()
-times = open(sys.argv[2]).read().splitlines()
-start = float(sys.argv[3])
-keep = [i for i, t in enumerate(times) if t.strip() and float(t) >= start - 1e-9]
-with open(os.path.join(sys.argv[4], "window.txt"), "w") as f:
-    f.write("".join(poses[i] + "\n" for i in keep))
-with open(os.path.join(sys.argv[4], "window_times.txt"), "w") as f:
-    f.write("".join(times[i] + "\n" for i in keep))
-PY
-  traj=(--trajectory "$OUT/window.txt" --times "$OUT/window_times.txt")
+  python3 tests/bench/kitti00_window.py "$DATA/KITTI_00_gt.txt" "$DATA/KITTI_00_gt_times.txt" \
+    "$START_S" "$OUT"
+  traj=(--trajectory "$OUT/kitti00_window.txt" --times "$OUT/kitti00_window_times.txt")
   route="KITTI-00 from ${START_S} s"
 else
   echo "bench: no KITTI-00 ground truth in $DATA: the demo route (35 s)" >&2

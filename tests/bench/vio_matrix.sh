@@ -93,17 +93,8 @@ simulate_drive() {
     # The window as its own KITTI trajectory (poses in KITTI-00's world; the simulator starts the
     # stamps at its default epoch), in a temporary folder: no copy of the shared data stays.
     tmp="$(mktemp -d)"
-    python3 - "$DATA/KITTI_00_gt.txt" "$DATA/KITTI_00_gt_times.txt" "$start" "$tmp" <<'PY'
-import os, sys
-poses = open(sys.argv[1]).read().splitlines()
-times = open(sys.argv[2]).read().splitlines()
-start = float(sys.argv[3])
-keep = [i for i, t in enumerate(times) if t.strip() and float(t) >= start - 1e-9]
-with open(os.path.join(sys.argv[4], "kitti00_window.txt"), "w") as f:
-    f.write("".join(poses[i] + "\n" for i in keep))
-with open(os.path.join(sys.argv[4], "kitti00_window_times.txt"), "w") as f:
-    f.write("".join(times[i] + "\n" for i in keep))
-PY
+    python3 tests/bench/kitti00_window.py "$DATA/KITTI_00_gt.txt" "$DATA/KITTI_00_gt_times.txt" \
+      "$start" "$tmp"
     traj=(--trajectory "$tmp/kitti00_window.txt" --times "$tmp/kitti00_window_times.txt")
   fi
   echo "bench: simulating $style seed $seed (${DRIVE_S} s from ${start} s) into $cache" >&2
