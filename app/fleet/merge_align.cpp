@@ -225,7 +225,7 @@ void solveJoint(std::vector<Drive>& drives, std::vector<CrossLoop>& loops, std::
 
 std::string csvText(const std::vector<MergeRun>& runs, const std::vector<Drive>& drives,
                     const std::vector<Row>& rows) {
-  std::string text = fmt::format("query_drive,candidate_drive,{}\n", io::kLoopsCsvHeader);
+  std::string text = alignmentLoopsHeader();
   for (const Row& r : rows) {
     text += fmt::format("{},{},{}\n", runs[drives[r.q].run].name, runs[drives[r.c].run].name,
                         io::loopsCsvLine(r.csv));
@@ -234,6 +234,10 @@ std::string csvText(const std::vector<MergeRun>& runs, const std::vector<Drive>&
 }
 
 }  // namespace
+
+std::string alignmentLoopsHeader() {
+  return fmt::format("query_drive,candidate_drive,{}\n", io::kLoopsCsvHeader);
+}
 
 MergeAlignment alignDrives(const std::vector<MergeRun>& runs, const run::LoopStageConfig& config,
                            const fusion::FusionConfig& fusion) {
@@ -309,6 +313,7 @@ nlohmann::json alignmentJson(const std::vector<MergeRun>& runs, const MergeAlign
   }
   return {{"attempted", a.attempted},
           {"solved", a.solved},
+          {"error", a.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.error)},
           {"pairs_in_radius", a.pairs_in_radius},
           {"verified", a.verified},
           {"accepted", a.accepted},

@@ -50,7 +50,8 @@ struct MergeAlignment {
   std::size_t pairs_in_radius = 0, verified = 0, accepted = 0, active = 0;
   fusion::GlobalGraphResult graph;
   double ms_detection = 0.0;
-  std::string csv;  // alignment_loops.csv
+  std::string csv;    // alignment_loops.csv
+  std::string error;  // why the alignment failed (the drives were merged as they are)
 };
 
 // Reads every run's keyframes.bin (InputError for a malformed one), detects and verifies loops
@@ -58,6 +59,9 @@ struct MergeAlignment {
 // loops.* and fusion.* (detection thresholds, graph and VIO noise).
 MergeAlignment alignDrives(const std::vector<MergeRun>& runs, const run::LoopStageConfig& loops,
                            const fusion::FusionConfig& fusion);
+
+// alignment_loops.csv's first line: loops.csv's columns after query_drive,candidate_drive.
+std::string alignmentLoopsHeader();
 
 nlohmann::json alignmentJson(const std::vector<MergeRun>& runs, const MergeAlignment& a);
 

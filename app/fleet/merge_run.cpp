@@ -89,7 +89,19 @@ MergeSummary runMerge(const MergeRequest& request) {
 
   MergeAlignment alignment;
   if (request.config.align) {
-    alignment = alignDrives(runs, request.loops, request.fusion);
+    try {
+      alignment = alignDrives(runs, request.loops, request.fusion);
+    } catch (const InvalidInput&) {
+      throw;  // a damaged keyframes.bin or a bad loops.* value: the user's to mend
+    } catch (const std::exception& e) {
+      // A bug or an odd drive inside the alignment costs the alignment, never the merge.
+      spdlog::warn("merge: the joint alignment failed ({}): the drives are merged as they are",
+                   e.what());
+      alignment = MergeAlignment{};
+      alignment.drives.resize(runs.size());
+      alignment.error = e.what();
+      alignment.csv = alignmentLoopsHeader();
+    }
     io::writeTextAtomic(request.out_dir / "alignment.json",
                         alignmentJson(runs, alignment).dump(2) + "\n");
     io::writeTextAtomic(request.out_dir / "alignment_loops.csv", alignment.csv);
