@@ -11,6 +11,7 @@
 #include "io/loops_csv.hpp"
 #include "io/place_database_io.hpp"
 #include "odometry/lie.hpp"
+#include "run/stats.hpp"
 
 namespace gvio::fleet {
 namespace {
@@ -213,12 +214,11 @@ void solveJoint(std::vector<Drive>& drives, std::vector<CrossLoop>& loops, std::
       const Eigen::Matrix3d dR = T_new.back().rotation() * T_old.back().rotation().transpose();
       m.rotated_max_deg = std::max(m.rotated_max_deg, degrees(odometry::logSo3(dR).norm()));
     }
-    double sum = 0.0;
-    for (double v : moved) sum += v;
-    m.moved_mean_m = sum / static_cast<double>(moved.size());
-    std::sort(moved.begin(), moved.end());
-    m.moved_max_m = moved.back();
-    m.moved_p95_m = moved[static_cast<std::size_t>(0.95 * static_cast<double>(moved.size() - 1))];
+    // The run's timing summary (mean, nearest-rank p95, max) serves distances as well.
+    const run::TimingSummary summary = run::summarizeTimings(std::move(moved));
+    m.moved_mean_m = summary.mean;
+    m.moved_p95_m = summary.p95;
+    m.moved_max_m = summary.max;
     out.corrections[drive.run].emplace(T_old, T_new);
   }
 }
