@@ -1,5 +1,6 @@
 #include "fleet/merge_run.hpp"
 
+#include <malloc.h>
 #include <unistd.h>
 
 #include <fmt/format.h>
@@ -75,10 +76,23 @@ void removeStaleTiles(const fs::path& tiles_dir, const std::set<std::string>& wr
   }
 }
 
+// A merge streams each run's cloud and each tile through buffers of tens to hundreds of MB that
+// live for one run or one tile. glibc serves those from fresh mmaps and unmaps them when freed,
+// so every one is faulted in again page by page: that took half of a merge's time on a virtual
+// machine (measured: 10 KITTI-00 runs merged in 60.5 s, 32.1 s with the heap kept). Kept in the
+// heap instead, a freed buffer is reused by the next run or tile; the peak stays the same, as the
+// buffers of a run or a tile are never alive together with the next one's.
+void keepLargeBuffersInTheHeap() {
+  constexpr int kThresholdBytes = 1 << 30;
+  mallopt(M_MMAP_THRESHOLD, kThresholdBytes);
+  mallopt(M_TRIM_THRESHOLD, kThresholdBytes);
+}
+
 }  // namespace
 
 MergeSummary runMerge(const MergeRequest& request) {
   const auto start = std::chrono::steady_clock::now();
+  keepLargeBuffersInTheHeap();
   request.config.validate();
   const std::vector<MergeRun> runs = resolveMergeRuns(request.runs);
   const MergeFrame frame = chooseMergeFrame(runs, request.config);
