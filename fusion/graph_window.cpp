@@ -27,6 +27,10 @@ void GraphWindow::addGnssFactor(GraphNode& node, std::shared_ptr<ceres::CostFunc
   node.unary.push_back(std::move(factor));
 }
 
+void GraphWindow::addPrior(GraphNode& node, std::shared_ptr<ceres::CostFunction> factor) {
+  node.exact.push_back(std::move(factor));
+}
+
 void GraphWindow::solve() {
   if (nodes_.empty()) return;
   ceres::Problem::Options popts;
@@ -40,6 +44,7 @@ void GraphWindow::solve() {
     GraphNode& n = *nodes_[k];
     problem.AddParameterBlock(n.pose.data(), odometry::kPoseAmbient, &manifold_);
     for (const auto& f : n.unary) problem.AddResidualBlock(f.get(), loss_.get(), n.pose.data());
+    for (const auto& f : n.exact) problem.AddResidualBlock(f.get(), nullptr, n.pose.data());
     if (k > 0 && n.relative) {
       problem.AddResidualBlock(n.relative.get(), nullptr, nodes_[k - 1]->pose.data(),
                                n.pose.data());
@@ -72,6 +77,10 @@ void GraphWindow::marginalizeOldest() {
   }
   for (const auto& f : oldest.unary) {
     m.addResidualBlock(f, loss_, {oldest.pose.data()});
+    named = true;
+  }
+  for (const auto& f : oldest.exact) {
+    m.addResidualBlock(f, nullptr, {oldest.pose.data()});
     named = true;
   }
   if (next.relative) {

@@ -26,6 +26,9 @@ struct GraphNode {
   // Factors attached to this node that involve only it and its predecessor (the relative factor)
   // or only it (GNSS): folded into the prior when the node leaves.
   std::vector<std::shared_ptr<ceres::CostFunction>> unary;
+  // Unary factors without the robust loss: priors the node carries from the VIO (its tilt) or from
+  // the registration (the first node's heading), which are never outliers.
+  std::vector<std::shared_ptr<ceres::CostFunction>> exact;
   std::shared_ptr<ceres::CostFunction> relative;  // to the previous node (null for the first)
   [[nodiscard]] Eigen::Isometry3d T_enu_b() const { return odometry::poseFromBlock(pose.data()); }
 };
@@ -38,6 +41,8 @@ class GraphWindow {
   GraphNode& addNode(std::int64_t t_ns, const Eigen::Isometry3d& T_enu_b,
                      const Eigen::Isometry3d& T_w_b, std::shared_ptr<ceres::CostFunction> relative);
   void addGnssFactor(GraphNode& node, std::shared_ptr<ceres::CostFunction> factor);
+  // A unary factor without the robust loss (GraphNode::exact).
+  void addPrior(GraphNode& node, std::shared_ptr<ceres::CostFunction> factor);
   // Solves the window, then marginalises nodes beyond max_nodes.
   void solve();
 
