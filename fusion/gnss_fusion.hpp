@@ -44,11 +44,11 @@ struct FusionConfig {
   double vio_sigma_floor_m = 0.02;
   double vio_rot_drift_rad_per_m = 1e-5;
   double vio_rot_floor_rad = 5e-4;
-  // With an IMU (alignment kYawTranslation): the smoother's nodes keep the roll and pitch the VIO
-  // observed, within this 1 sigma (TiltFactor). Fixes and relative poses alone leave the roll
-  // about a straight path free: a 12 s straight drive came out rolled 42 deg. (The online window
-  // keeps its freedom: its first nodes' heading rests on a few fixes and the lever arm, and a
-  // held tilt left them turned 44 deg for seconds on a synthetic drive, until the gate let go.)
+  // With an IMU (alignment kYawTranslation): the nodes of the online window and of the smoother
+  // keep the roll and pitch the VIO observed, within this 1 sigma (TiltFactor). Fixes and relative
+  // poses alone leave the roll about a straight path free: a 12 s straight drive came out rolled
+  // 42 deg. With the tilt held, the first node's heading no longer shows in its fix (the lever
+  // arm turns with it about the vertical), so it keeps the registration's (a yaw prior).
   double tilt_sigma_deg = 1.0;
   int window_nodes = 20;
   double huber_sigmas = 2.0;
