@@ -99,7 +99,13 @@ void readFrames(const fs::path& drive_dir, const std::vector<int>& ids, Dataset&
     for (const int id : ids) {
       const fs::path image =
           indexedFile(drive_dir / fmt::format("image_{:02d}", id) / "data", i, ".png");
-      if (!fs::is_regular_file(image)) throw InputError(image, 0, "image file not found");
+      if (!fs::is_regular_file(image)) {
+        // Named with the timestamp that lists it: either file may be the one at fault.
+        throw InputError(
+            image, 0,
+            fmt::format("image file not found (listed by line {} of {})", i + 1,
+                        (drive_dir / fmt::format("image_{:02d}", id) / "timestamps.txt").string()));
+      }
       ds.frames[i].image_paths.push_back(image);
     }
   }
@@ -131,6 +137,13 @@ void readOxts(const fs::path& drive_dir, bool gnss_from_oxts, Dataset& ds) {
   ds.imu.reserve(stamps.size());
   for (std::size_t i = 0; i < stamps.size(); ++i) {
     const fs::path file = indexedFile(oxts_dir / "data", i, ".txt");
+    if (!fs::is_regular_file(file)) {
+      // Named with the timestamp that lists it: either file may be the one at fault (found by
+      // fuzzing timestamps.txt: a line more than the records named only the record).
+      throw InputError(file, 0,
+                       fmt::format("file not found (the record of line {} of {})", i + 1,
+                                   (oxts_dir / "timestamps.txt").string()));
+    }
     const auto rec = readOxtsRecord(file);
     ImuSample s;
     s.t_ns = stamps[i];
