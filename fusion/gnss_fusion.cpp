@@ -325,9 +325,10 @@ bool GnssFusion::Impl::fuseGraph(const Pair& pair) {
 // as the smoother does): fixes alone leave the roll about a straight stretch free, and with the
 // antenna above the body the fixes' lateral noise then rolls the online poses by tens of degrees
 // (31.7 deg at worst, 2.9 deg median, on 60 s of simulated KITTI-00 with SPP fixes). Held at its
-// tilt, a node's heading moves nothing the fixes see (the lever arm is vertical), so the first node
-// also keeps the registration's heading, within what the registration's fixes say of it; later
-// nodes get their heading through the VIO's relative poses, as before.
+// tilt, a lone node's heading moves its antenna only through the lever arm's horizontal part (not
+// at all for an antenna above the body), so the first node also keeps the registration's heading,
+// within what the registration's fixes say of it; later nodes get their heading through the VIO's
+// relative poses and the track of the fixes, as before.
 void GnssFusion::Impl::addNodePriors(GraphNode& node, bool first) {
   const double tilt_sigma = config.tiltSigmaRad();
   if (tilt_sigma <= 0.0) return;  // no IMU: the VIO's world is not levelled

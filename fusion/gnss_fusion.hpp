@@ -47,8 +47,9 @@ struct FusionConfig {
   // With an IMU (alignment kYawTranslation): the nodes of the online window and of the smoother
   // keep the roll and pitch the VIO observed, within this 1 sigma (TiltFactor). Fixes and relative
   // poses alone leave the roll about a straight path free: a 12 s straight drive came out rolled
-  // 42 deg. With the tilt held, the first node's heading no longer shows in its fix (the lever
-  // arm turns with it about the vertical), so it keeps the registration's (a yaw prior).
+  // 42 deg. With the tilt held, the first node's heading shows in its fix only through the lever
+  // arm's horizontal part (none for an antenna above the body), so it keeps the registration's
+  // heading (a yaw prior).
   double tilt_sigma_deg = 1.0;
   int window_nodes = 20;
   double huber_sigmas = 2.0;
