@@ -26,27 +26,6 @@ constexpr double kNoVelocityVariance = 1e8;
 constexpr double kFreeRad = 10.0;
 constexpr double kFreePositionM = 1e4;
 
-// The heading's 1-sigma (rad) that a yaw + translation registration on these fixes leaves: twice
-// the fixes' mean horizontal sigma across their horizontal span (a conservative bound: fixes at
-// both ends of a span L, each off by sigma, turn it by at most about 2 sigma / L).
-template <typename Pairs>
-double headingSigmaRad(const Pairs& pairs, const std::vector<bool>& use) {
-  double span = 0.0, sigma = 0.0;
-  int n = 0;
-  for (std::size_t i = 0; i < pairs.size(); ++i) {
-    if (!use[i]) continue;
-    sigma += pairs[i].fix.sigma_h_m;
-    ++n;
-    for (std::size_t j = 0; j < i; ++j) {
-      if (!use[j]) continue;
-      const Eigen::Vector3d d = pairs[i].p_enu - pairs[j].p_enu;
-      span = std::max(span, std::hypot(d.x(), d.y()));
-    }
-  }
-  if (n == 0 || span <= 0.0) return kFreeRad;
-  return std::atan2(2.0 * sigma / n, span);
-}
-
 }  // namespace
 
 std::string toString(FixStatus status) {
@@ -131,6 +110,7 @@ struct GnssFusion::Impl {
       const Eigen::Isometry3d& T_ls) const;
   bool fuseGraph(const Pair& pair);
   void addNodePriors(GraphNode& node, bool first);
+  [[nodiscard]] double registrationHeadingSigmaRad(const std::vector<bool>& use) const;
   bool fuseKf(const Pair& pair);
   Eigen::Isometry3d fusedPose(std::int64_t t_ns, const Eigen::Isometry3d& T_w_b) const;
   void noteAccepted(std::int64_t t_ns);
@@ -251,6 +231,26 @@ std::optional<std::vector<bool>> GnssFusion::Impl::registrationPairs(
   return inliers;
 }
 
+// The heading's 1-sigma (rad) that a yaw + translation registration on the used pairs leaves:
+// twice the fixes' mean horizontal sigma across their horizontal span (a conservative bound:
+// fixes at both ends of a span L, each off by sigma, turn it by at most about 2 sigma / L).
+double GnssFusion::Impl::registrationHeadingSigmaRad(const std::vector<bool>& use) const {
+  double span = 0.0, sigma = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i < alignment_pairs.size(); ++i) {
+    if (!use[i]) continue;
+    sigma += alignment_pairs[i].fix.sigma_h_m;
+    ++n;
+    for (std::size_t j = 0; j < i; ++j) {
+      if (!use[j]) continue;
+      const Eigen::Vector3d d = alignment_pairs[i].p_enu - alignment_pairs[j].p_enu;
+      span = std::max(span, std::hypot(d.x(), d.y()));
+    }
+  }
+  if (n == 0 || span <= 0.0) return kFreeRad;
+  return std::atan2(2.0 * sigma / n, span);
+}
+
 void GnssFusion::Impl::align(const Pair& pair) {
   alignment_pairs.push_back(pair);
   if (static_cast<int>(alignment_pairs.size()) < config.alignment_min_fixes) return;
@@ -267,7 +267,7 @@ void GnssFusion::Impl::align(const Pair& pair) {
     T_enu_w = registration(use);
     if (!T_enu_w) return;
   }
-  registration_yaw_sigma_rad = headingSigmaRad(alignment_pairs, use);
+  registration_yaw_sigma_rad = registrationHeadingSigmaRad(use);
   // Back-fill the poses seen so far with the registration, then start the chosen filter; the
   // pairs outside the consensus are rejected.
   stats.poses_before_alignment = static_cast<int>(vio.size());

@@ -43,6 +43,17 @@ fs::path indexedFile(const fs::path& dir, std::size_t index, const char* ext) {
   return dir / fmt::format("{:010d}{}", index, ext);
 }
 
+// The data file of the index-th timestamp must exist. Its error names the line of timestamps.txt
+// that lists it too: either file may be the one at fault (found by fuzzing timestamps.txt: a line
+// more than the records named only the record).
+void requireListed(const fs::path& file, const fs::path& stamps, std::size_t index,
+                   const char* what) {
+  if (fs::is_regular_file(file)) return;
+  throw InputError(
+      file, 0,
+      fmt::format("{} not found (listed by line {} of {})", what, index + 1, stamps.string()));
+}
+
 std::vector<double> readOxtsRecord(const fs::path& file) {
   LineReader reader(file);
   std::string line;
@@ -99,13 +110,8 @@ void readFrames(const fs::path& drive_dir, const std::vector<int>& ids, Dataset&
     for (const int id : ids) {
       const fs::path image =
           indexedFile(drive_dir / fmt::format("image_{:02d}", id) / "data", i, ".png");
-      if (!fs::is_regular_file(image)) {
-        // Named with the timestamp that lists it: either file may be the one at fault.
-        throw InputError(
-            image, 0,
-            fmt::format("image file not found (listed by line {} of {})", i + 1,
-                        (drive_dir / fmt::format("image_{:02d}", id) / "timestamps.txt").string()));
-      }
+      requireListed(image, drive_dir / fmt::format("image_{:02d}", id) / "timestamps.txt", i,
+                    "image file");
       ds.frames[i].image_paths.push_back(image);
     }
   }
@@ -137,13 +143,7 @@ void readOxts(const fs::path& drive_dir, bool gnss_from_oxts, Dataset& ds) {
   ds.imu.reserve(stamps.size());
   for (std::size_t i = 0; i < stamps.size(); ++i) {
     const fs::path file = indexedFile(oxts_dir / "data", i, ".txt");
-    if (!fs::is_regular_file(file)) {
-      // Named with the timestamp that lists it: either file may be the one at fault (found by
-      // fuzzing timestamps.txt: a line more than the records named only the record).
-      throw InputError(file, 0,
-                       fmt::format("file not found (the record of line {} of {})", i + 1,
-                                   (oxts_dir / "timestamps.txt").string()));
-    }
+    requireListed(file, oxts_dir / "timestamps.txt", i, "file");
     const auto rec = readOxtsRecord(file);
     ImuSample s;
     s.t_ns = stamps[i];

@@ -106,7 +106,7 @@ TEST(GnssFusion, GraphKeepsTheVioTiltOnline) {
   const double tilt = maxTiltErrorDeg(d.truth, graph.fused);
   std::printf("online tilt error at most %.2f deg\n", tilt);
   EXPECT_LT(tilt, 1.0);
-  // Without an IMU (full-rotation registration) the window has no tilt to keep, and runs as before.
+  // Without an IMU (full-rotation registration) the VIO's world is not levelled: no tilt is held.
   FusionConfig config;
   config.lever_arm_b = d.lever;
   config.alignment = AlignmentDof::kRotationTranslation;
