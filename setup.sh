@@ -148,8 +148,10 @@ case "$mode" in
     done
     # The map over the recorded left camera 12 s into the drive.
     "$BUILD_DIR/app/gvio" render --run out/demo/run --view camera --at 12 --out out/demo/run/render/camera.png
+    # The map checked against every keyframe's recorded image (no ground truth needed).
+    "$BUILD_DIR/app/gvio" consistency --run out/demo/run --images
     echo "setup: demo drive in out/demo/drive, run (trajectories, map.pcd/ply/las/bt/ot, report.json)" \
-      "in out/demo/run, images in out/demo/run/render"
+      "in out/demo/run, images in out/demo/run/render, the image check in out/demo/run/consistency_images"
     ;;
   *)
     echo "usage: ./setup.sh [demo|test|build|sanitize [quick|thread]|fuzz [SECONDS [TARGET...]]]" >&2

@@ -109,7 +109,7 @@ int runMain(int argc, char** argv) {
   commands.push_back(addSimulateCommand(app, common));
   commands.push_back(addRunCommand(app, common));
   commands.push_back(addExportCommand(app));
-  commands.push_back(addConsistencyCommand(app));
+  commands.push_back(addConsistencyCommand(app, common));
   commands.push_back(addFleetCommand(app));
   commands.push_back(addFleetTaskCommand(app));
   commands.push_back(addMergeCommand(app));

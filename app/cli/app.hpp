@@ -42,7 +42,7 @@ Command addRenderCommand(CLI::App& app, const CommonOptions& common);
 Command addSimulateCommand(CLI::App& app, const CommonOptions& common);
 Command addRunCommand(CLI::App& app, const CommonOptions& common);
 Command addExportCommand(CLI::App& app);
-Command addConsistencyCommand(CLI::App& app);
+Command addConsistencyCommand(CLI::App& app, const CommonOptions& common);
 Command addFleetCommand(CLI::App& app);
 Command addFleetTaskCommand(CLI::App& app);
 Command addMergeCommand(CLI::App& app);

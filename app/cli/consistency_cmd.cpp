@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "cli/app.hpp"
+#include "cli/consistency_images.hpp"
 #include "fleet/merged_consistency.hpp"
 #include "io/atomic_write.hpp"
 #include "io/input_error.hpp"
@@ -34,6 +35,8 @@ struct ConsistencyOptions {
   std::optional<std::string> json;
   std::optional<std::string> reference_origin;  // merged maps: the mesh's ENU origin
   double max_distance_m = 2.0;
+  bool images = false;  // against the recorded images instead of a mesh
+  ImageConsistencyRequest image_check;
 };
 
 // Points of a merged map compared at most (thinned evenly per tile).
@@ -92,10 +95,20 @@ std::unique_ptr<octomap::OcTree> readOcTree(const fs::path& file) {
   return tree;
 }
 
-int runConsistency(const ConsistencyOptions& o) {
+int runConsistency(const ConsistencyOptions& o, ProgressStyle progress) {
   if (!(o.max_distance_m > 0.0)) throw InvalidInput("--max-distance must be > 0");
   const fs::path run(o.run);
   if (!fs::is_directory(run)) throw io::InputError(run, 0, "run folder not found");
+  if (o.images == !o.reference.empty()) {
+    throw InvalidInput("give either --reference MESH.ply or --images");
+  }
+  if (o.images) {
+    ImageConsistencyRequest r = o.image_check;
+    r.run = run;
+    if (o.json) r.json = *o.json;
+    r.progress = progress;
+    return runImageConsistency(r);
+  }
   if (fleet::isMergedMap(run) && !fs::exists(run / "map.pcd")) return runMergedConsistency(o);
   if (o.reference_origin) {
     throw InvalidInput(
@@ -145,15 +158,34 @@ int runConsistency(const ConsistencyOptions& o) {
 
 }  // namespace
 
-Command addConsistencyCommand(CLI::App& app) {
+Command addConsistencyCommand(CLI::App& app, const CommonOptions& common) {
   auto o = std::make_shared<ConsistencyOptions>();
   CLI::App* sub = app.add_subcommand(
       "consistency",
-      "Compare a run's map (map.pcd, map.bt) or a merged map (tiles) with a reference mesh");
+      "Compare a run's map (map.pcd, map.bt) or a merged map (tiles) with a reference mesh, or "
+      "a run's map with its recorded images (--images)");
   sub->add_option("--run", o->run, "Run folder (the --out of gvio run)")->required();
   sub->add_option("--reference", o->reference,
-                  "Reference triangle mesh (PLY) in the run's map frame (local ENU)")
-      ->required();
+                  "Reference triangle mesh (PLY) in the run's map frame (local ENU)");
+  sub->add_flag("--images", o->images,
+                "No reference: render the map into every keyframe's camera (leaving out the "
+                "points of keyframes within --exclude s) and compare with its recorded image and "
+                "stereo depth");
+  ImageConsistencyRequest& ic = o->image_check;
+  sub->add_option("--out", ic.out, "--images: report folder (default RUN/consistency_images)");
+  sub->add_option("--dataset", ic.dataset,
+                  "--images: the dataset, if it moved since the run (default: report.json's)");
+  sub->add_option("--every", ic.every, "--images: check every n-th map keyframe")
+      ->capture_default_str();
+  sub->add_option("--at", ic.at_s, "--images: check only the keyframe nearest T s into the drive");
+  sub->add_option("--from", ic.from_s, "--images: check only keyframes from S s into the drive");
+  sub->add_option("--to", ic.to_s, "--images: ... up to S s into the drive");
+  sub->add_option("--exclude", ic.check.exclude_s,
+                  "--images: leave out the points of keyframes closer than this in time (s)")
+      ->capture_default_str();
+  sub->add_option("--worst", ic.worst_images,
+                  "--images: side-by-side images of this many worst keyframes")
+      ->capture_default_str();
   sub->add_option("--json", o->json, "Write the metrics as JSON");
   sub->add_option("--reference-origin", o->reference_origin,
                   "Merged maps (gvio merge): the mesh's local ENU origin lat,lon,h (default: the "
@@ -161,7 +193,7 @@ Command addConsistencyCommand(CLI::App& app) {
   sub->add_option("--max-distance", o->max_distance_m,
                   "Search radius (m): points farther from the surface count as this distance")
       ->capture_default_str();
-  return {sub, [o] { return runConsistency(*o); }};
+  return {sub, [o, &common] { return runConsistency(*o, common.progressStyle()); }};
 }
 
 }  // namespace gvio::cli

@@ -43,9 +43,10 @@ std::size_t nearestFrame(const io::Dataset& ds, std::int64_t t_ns) {
   return best;
 }
 
-// The dataset as the run opened it: its sources and its reader configuration (config.yaml).
-io::Dataset reopenDataset(const fs::path& run_dir, const std::optional<fs::path>& dataset,
-                          std::string& mode) {
+}  // namespace
+
+io::Dataset reopenRunDataset(const fs::path& run_dir, const std::optional<fs::path>& dataset,
+                             std::string& mode) {
   const fs::path report = run_dir / "report.json";
   const io::RunSources recorded = io::readRunSources(report);
   mode = recorded.mode;
@@ -64,6 +65,8 @@ io::Dataset reopenDataset(const fs::path& run_dir, const std::optional<fs::path>
   return io::openDataset(sources, app.dataset);
 }
 
+namespace {
+
 bool stereoMode(const fs::path& run_dir, const std::string& mode) {
   try {
     return odometry::usesStereo(odometry::parseVioMode(mode));
@@ -72,6 +75,8 @@ bool stereoMode(const fs::path& run_dir, const std::string& mode) {
                          "the run has no camera trajectory (mode \"" + mode + "\")");
   }
 }
+
+}  // namespace
 
 io::RunFiles readMapRun(const fs::path& run_dir) {
   if (const auto warning = io::incompleteRunWarning(run_dir)) spdlog::warn("{}", *warning);
@@ -83,8 +88,6 @@ io::RunFiles readMapRun(const fs::path& run_dir) {
   }
   return run;
 }
-
-}  // namespace
 
 struct RecordedCameraOverlay::State {
   io::RunFiles run;
@@ -107,7 +110,7 @@ RecordedCameraOverlay::RecordedCameraOverlay(const fs::path& run_dir,
   State& s = *state_;
   s.run = readMapRun(run_dir);
   std::string mode;
-  s.ds = reopenDataset(run_dir, dataset, mode);
+  s.ds = reopenRunDataset(run_dir, dataset, mode);
   if (s.ds.cameras.empty()) throw InvalidInput(s.ds.root.string() + ": no camera");
   s.stereo = stereoMode(run_dir, mode) && s.ds.cameras.size() >= 2;
   s.rectifier.emplace(s.ds.cameras[0],
@@ -115,14 +118,7 @@ RecordedCameraOverlay::RecordedCameraOverlay(const fs::path& run_dir,
   s.options = options;
   s.overlay = overlay;
   const CameraModel& cam = s.rectifier->left();
-  s.K.fx = cam.fx;
-  s.K.fy = cam.fy;
-  s.K.cx = cam.cx;
-  s.K.cy = cam.cy;
-  s.K.width = cam.width_px;
-  s.K.height = cam.height_px;
-  s.K.near_m = 0.3;
-  s.K.far_m = 2.0 * options.max_depth_m;
+  s.K = viz::renderIntrinsics(cam, 0.3, 2.0 * options.max_depth_m);
   s.target.emplace(s.K.width, s.K.height);
 }
 

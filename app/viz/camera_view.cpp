@@ -72,6 +72,19 @@ MapColour parseMapColour(const std::string& name) {
   throw InvalidInput("unknown map colour '" + name + "' (expected depth or intensity)");
 }
 
+render::PinholeIntrinsics renderIntrinsics(const CameraModel& camera, double near_m, double far_m) {
+  render::PinholeIntrinsics K;
+  K.fx = camera.fx;
+  K.fy = camera.fy;
+  K.cx = camera.cx;
+  K.cy = camera.cy;
+  K.width = camera.width_px;
+  K.height = camera.height_px;
+  K.near_m = near_m;
+  K.far_m = far_m;
+  return K;
+}
+
 const Trajectory& mapTrajectory(const io::RunFiles& run) {
   if (run.fused && !run.fused->empty()) return *run.fused;
   if (run.vio && !run.vio->empty()) return *run.vio;

@@ -12,6 +12,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "io/run_dir.hpp"
+#include "odometry/measurements.hpp"
 #include "render/camera.hpp"
 #include "render/image.hpp"
 #include "render/scene.hpp"
@@ -27,6 +28,9 @@ OverlayMode parseOverlayMode(const std::string& name);  // InvalidInput for anyt
 // the image they were seen in (map.pcd's intensity), which the recorded image should repeat.
 enum class MapColour { kDepth, kIntensity };
 MapColour parseMapColour(const std::string& name);  // InvalidInput for anything else
+
+// The render intrinsics of a rectified (pinhole, undistorted) camera.
+render::PinholeIntrinsics renderIntrinsics(const CameraModel& camera, double near_m, double far_m);
 
 // The trajectory map.pcd is expressed along: trajectory.tum, else trajectory_vio.tum.
 const Trajectory& mapTrajectory(const io::RunFiles& run);

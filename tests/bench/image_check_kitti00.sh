@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# gvio consistency --images on the simulated KITTI-00 run (issue 19: <= 150 ms per keyframe at
+# 1241x376 for the 14 M-point map; the map of true poses scoring above the SPP-fused one's, above
+# the VIO's). The run folder's map is checked along three trajectories: `truth` (the simulator's
+# groundtruth.tum), `fused` (the run's trajectory.tum: graph fusion of SPP fixes + loops) and `vio`
+# (trajectory_vio.tum: the VIO alone, no loops, no GNSS). Each is a folder holding only the run's
+# report.json and config.yaml (the dataset and the map settings) and that trajectory, so the check
+# rebuilds the map from it. Prints one table. A benchmark, not a test: nothing asserts.
+#
+# BENCH_RUN: the run folder (default: the KITTI-00 graph+loops run of tests/bench/vio_kitti00.sh).
+# BENCH_TRAJ: which of truth fused vio (default all three). BENCH_ARGS: more consistency options
+# (e.g. "--from 30 --to 60"). Work folder: BENCH_OUT (default build/bench_image_check).
+#
+#   tests/bench/image_check_kitti00.sh
+#   BENCH_TRAJ=fused BENCH_ARGS="--every 5" tests/bench/image_check_kitti00.sh
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+BUILD_DIR="${BUILD_DIR:-build}"
+GVIO="$(pwd)/$BUILD_DIR/app/gvio"
+RUN="${BENCH_RUN:-out/bench/vio_kitti00_full/stereo-imu_graph}"
+OUT="${BENCH_OUT:-$BUILD_DIR/bench_image_check}"
+TRAJ="${BENCH_TRAJ:-truth fused vio}"
+[ -x "$GVIO" ] || { echo "bench: build gvio first ($GVIO)" >&2; exit 2; }
+for f in report.json trajectory.tum trajectory_vio.tum groundtruth.tum; do
+  [ -f "$RUN/$f" ] || { echo "bench: $RUN has no $f (set BENCH_RUN)" >&2; exit 2; }
+done
+rm -rf "$OUT"
+mkdir -p "$OUT"
+for t in $TRAJ; do
+  mkdir -p "$OUT/$t"
+  cp "$RUN/report.json" "$OUT/$t/"
+  [ -f "$RUN/config.yaml" ] && cp "$RUN/config.yaml" "$OUT/$t/"
+  case "$t" in
+    truth) cp "$RUN/groundtruth.tum" "$OUT/$t/trajectory.tum" ;;
+    fused) cp "$RUN/trajectory.tum" "$OUT/$t/trajectory.tum" ;;
+    vio) cp "$RUN/trajectory_vio.tum" "$OUT/$t/trajectory_vio.tum" ;;
+    *) echo "bench: unknown trajectory $t (truth, fused or vio)" >&2; exit 2 ;;
+  esac
+  # shellcheck disable=SC2086
+  /usr/bin/time -f "%e %M" -o "$OUT/$t.time" "$GVIO" --no-progress consistency --run "$OUT/$t" \
+    --images ${BENCH_ARGS:-} > "$OUT/$t.log" 2>&1
+done
+python3 - "$OUT" $TRAJ <<'PY'
+import json, sys
+out, names = sys.argv[1], sys.argv[2:]
+print("| trajectory | keyframes | ZNCC mean | depth agreement mean | flagged (stretches) | ms per keyframe mean / median / p90 | wall s | peak RSS MiB |")
+print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+for n in names:
+    j = json.load(open(f"{out}/{n}/consistency_images/summary.json"))
+    wall, rss_kb = open(f"{out}/{n}.time").read().split()
+    ms = j["ms_per_keyframe"]
+    print(f"| {n} | {j['keyframes']['checked']} | {j['ncc']['mean']:.3f} | "
+          f"{j['depth_agreement']['mean']:.3f} | {j['keyframes']['flagged']} "
+          f"({len(j['flagged_stretches'])}) | {ms['mean']:.0f} / {ms['median']:.0f} / "
+          f"{ms['p90']:.0f} | {float(wall):.0f} | {int(rss_kb) / 1024:.0f} |")
+PY

@@ -1,0 +1,217 @@
+// mapping/image_consistency: the scores of a rendered map against a recorded image and stereo
+// depth, and the robust flagging of the views that disagree (issue 19's per-keyframe check).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "mapping/image_consistency.hpp"
+#include "odometry/error.hpp"
+
+namespace gvio::mapping {
+namespace {
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+// Blurred noise: texture at the scale of a few pixels, like a facade or asphalt.
+cv::Mat texture(int width, int height, unsigned seed) {
+  cv::Mat noise(height, width, CV_8UC1);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+  cv::GaussianBlur(noise, noise, {0, 0}, 1.5);
+  cv::normalize(noise, noise, 0, 255, cv::NORM_MINMAX);
+  return noise;
+}
+
+struct Views {
+  cv::Mat recorded, rendered, covered, rendered_depth, stereo_depth;
+};
+
+Views sameView(int width = 320, int height = 160) {
+  Views v;
+  v.recorded = texture(width, height, 1);
+  v.rendered = v.recorded.clone();
+  v.covered = cv::Mat(height, width, CV_8UC1, cv::Scalar(255));
+  v.rendered_depth = cv::Mat(height, width, CV_32FC1, cv::Scalar(10.0F));
+  v.stereo_depth = v.rendered_depth.clone();
+  return v;
+}
+
+constexpr double kFocalBaseline = 194.0;  // KITTI at half size, px m
+
+ViewScore score(const Views& v, const ImageConsistencyConfig& c = {}) {
+  return scoreView(v.recorded, v.rendered, v.covered, v.rendered_depth, v.stereo_depth,
+                   kFocalBaseline, c);
+}
+
+TEST(ImageConsistency, ZnccIsOneForTheSameImageAndIgnoresGainAndOffset) {
+  const cv::Mat a = texture(32, 32, 2);
+  const cv::Mat mask(32, 32, CV_8UC1, cv::Scalar(255));
+  EXPECT_NEAR(maskedZncc(a, a, mask, 1.0), 1.0, 1e-12);
+  cv::Mat b;
+  a.convertTo(b, CV_8UC1, 0.5, 40.0);
+  EXPECT_NEAR(maskedZncc(a, b, mask, 1.0), 1.0, 0.01);
+  cv::Mat inverted = 255 - a;
+  EXPECT_NEAR(maskedZncc(a, inverted, mask, 1.0), -1.0, 1e-9);
+  const cv::Mat flat(32, 32, CV_8UC1, cv::Scalar(90));
+  EXPECT_TRUE(std::isnan(maskedZncc(a, flat, mask, 1.0)));  // no texture: no verdict
+  EXPECT_TRUE(std::isnan(maskedZncc(a, a, cv::Mat::zeros(32, 32, CV_8UC1), 1.0)));
+}
+
+TEST(ImageConsistency, ZnccCountsOnlyTheMaskedPixels) {
+  const cv::Mat a = texture(32, 32, 3);
+  cv::Mat b = a.clone();
+  cv::Mat mask(32, 32, CV_8UC1, cv::Scalar(255));
+  b(cv::Rect(0, 0, 32, 8)).setTo(0);  // garbage where the render drew nothing
+  mask(cv::Rect(0, 0, 32, 8)).setTo(0);
+  EXPECT_NEAR(maskedZncc(a, b, mask, 1.0), 1.0, 1e-12);
+}
+
+TEST(ImageConsistency, ARenderInPlaceScoresHighAndAShiftedOneLow) {
+  const Views same = sameView();
+  const ViewScore good = score(same);
+  EXPECT_NEAR(good.ncc, 1.0, 1e-9);
+  EXPECT_EQ(good.patches, (320 / 16) * (160 / 16));
+  EXPECT_DOUBLE_EQ(good.coverage, 1.0);
+  EXPECT_DOUBLE_EQ(good.depth_agreement, 1.0);
+  Views shifted = same;
+  const cv::Mat M = (cv::Mat_<double>(2, 3) << 1, 0, 6, 0, 1, 0);  // 6 px to the right
+  cv::warpAffine(same.recorded, shifted.rendered, M, same.recorded.size(), cv::INTER_LINEAR,
+                 cv::BORDER_REFLECT);
+  EXPECT_LT(score(shifted).ncc, 0.3);
+}
+
+TEST(ImageConsistency, DepthAgreesWithinOneDisparityPixel) {
+  const ImageConsistencyConfig c;
+  // 1 px of disparity at 10 m with f b = 194 px m: 100 / 194 = 0.515 m.
+  EXPECT_NEAR(depthTolerance(10.0, kFocalBaseline, c), 100.0 / 194.0, 1e-12);
+  EXPECT_DOUBLE_EQ(depthTolerance(1.0, kFocalBaseline, c), c.depth_tolerance_m);  // the floor
+  Views v = sameView();
+  v.rendered_depth.setTo(10.4F);  // within 0.515 m
+  EXPECT_DOUBLE_EQ(score(v).depth_agreement, 1.0);
+  v.rendered_depth(cv::Rect(0, 0, 160, 160)).setTo(11.0F);  // half the image 1 m too deep
+  EXPECT_NEAR(score(v).depth_agreement, 0.5, 1e-12);
+  v.stereo_depth.setTo(0.0F);  // no stereo depth: not scored
+  EXPECT_TRUE(std::isnan(score(v).depth_agreement));
+  EXPECT_EQ(score(v).depth_pixels, 0U);
+}
+
+TEST(ImageConsistency, AnUncoveredViewIsNotScored) {
+  Views v = sameView();
+  v.covered.setTo(0);
+  const ViewScore s = score(v);
+  EXPECT_FALSE(s.hasNcc());
+  EXPECT_EQ(s.patches, 0);
+  EXPECT_DOUBLE_EQ(s.coverage, 0.0);
+}
+
+TEST(ImageConsistency, MismatchedImagesAndBadConfigAreRefused) {
+  Views v = sameView();
+  v.rendered_depth = cv::Mat(10, 10, CV_32FC1, cv::Scalar(1.0F));
+  EXPECT_THROW((void)score(v), InvalidInput);
+  v = sameView();
+  v.covered.convertTo(v.covered, CV_32F);
+  EXPECT_THROW((void)score(v), InvalidInput);
+  ImageConsistencyConfig c;
+  c.patch_px = 2;
+  EXPECT_THROW(c.validate(), InvalidInput);
+  c = {};
+  c.min_patch_coverage = 0.0;
+  EXPECT_THROW(c.validate(), InvalidInput);
+  c = {};
+  c.flag_sigmas = -1.0;
+  EXPECT_THROW(c.validate(), InvalidInput);
+  c = {};
+  c.local_window_s = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(c.validate(), InvalidInput);
+}
+
+// Scores along a drive: a slow trend (scenery) with noise, and `dip` subtracted on [from, to).
+std::vector<ViewScore> drive(std::size_t n, double dip, std::size_t from, std::size_t to) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  std::vector<ViewScore> views(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double trend = 0.45 + 0.3 * static_cast<double>(i) / static_cast<double>(n);
+    views[i].ncc = trend + noise(rng) - (i >= from && i < to ? dip : 0.0);
+    views[i].depth_agreement = 0.9 + 0.5 * noise(rng);
+    views[i].coverage = 0.4;
+  }
+  return views;
+}
+
+std::vector<double> times(std::size_t n) {
+  std::vector<double> t(n);
+  for (std::size_t i = 0; i < n; ++i) t[i] = 0.2 * static_cast<double>(i);
+  return t;
+}
+
+TEST(ImageConsistency, AShortDipIsFlaggedAndTheSceneryTrendIsNot) {
+  const std::size_t n = 300;
+  const FlaggedViews clean = flagOutliers(drive(n, 0.0, 0, 0), times(n), {});
+  for (std::size_t i = 0; i < n; ++i) EXPECT_FALSE(clean.flagged[i]) << i;
+  const FlaggedViews faulty = flagOutliers(drive(n, 0.25, 200, 210), times(n), {});
+  for (std::size_t i = 0; i < n; ++i) {
+    EXPECT_EQ(faulty.flagged[i], i >= 200 && i < 210) << i;
+  }
+  const auto stretches = flaggedStretches(faulty.flagged);
+  ASSERT_EQ(stretches.size(), 1U);
+  EXPECT_EQ(stretches[0].first, 200U);
+  EXPECT_EQ(stretches[0].last, 209U);
+  // A long bad stretch moves the local medians with it, and the drive's spread with them; the
+  // floor (ZNCC 0.15) still flags a map that does not correlate with its images.
+  const FlaggedViews long_fault = flagOutliers(drive(n, 0.6, 100, 170), times(n), {});
+  for (std::size_t i = 110; i < 160; ++i) EXPECT_TRUE(long_fault.flagged[i]) << i;
+  for (std::size_t i = 180; i < n; ++i) EXPECT_FALSE(long_fault.flagged[i]) << i;
+}
+
+TEST(ImageConsistency, UnscoredViewsAndShortDrivesNeverFlag) {
+  std::vector<ViewScore> views = drive(5, 0.5, 2, 3);
+  views[2].ncc = 0.3;  // far below the others, but above the floor
+  const FlaggedViews few = flagOutliers(views, times(5), {});
+  for (const bool f : few.flagged) EXPECT_FALSE(f);  // below min_views_to_flag
+  views[2].ncc = 0.1;
+  EXPECT_TRUE(flagOutliers(views, times(5), {}).flagged[2]);  // the floor holds on any drive
+  views = drive(100, 0.0, 0, 0);
+  views[50].ncc = kNan;
+  views[50].depth_agreement = kNan;
+  EXPECT_FALSE(flagOutliers(views, times(100), {}).flagged[50]);
+  EXPECT_THROW((void)flagOutliers(views, times(99), {}), InvalidInput);
+  std::vector<double> unsorted = times(100);
+  std::swap(unsorted[3], unsorted[4]);
+  EXPECT_THROW((void)flagOutliers(views, unsorted, {}), InvalidInput);
+}
+
+TEST(ImageConsistency, AThinlyCoveredViewIsFlaggedByTheFloorsOnly) {
+  std::vector<ViewScore> views = drive(100, 0.0, 0, 0);
+  views[99].ncc -= 0.25;  // the last keyframe: the map on one side only
+  views[99].coverage = 0.2;
+  EXPECT_FALSE(flagOutliers(views, times(100), {}).flagged[99]);
+  views[99].ncc = 0.1;
+  EXPECT_TRUE(flagOutliers(views, times(100), {}).flagged[99]);
+}
+
+TEST(ImageConsistency, TheDepthAgreementFlagsBelowItsFloorOnly) {
+  std::vector<ViewScore> views = drive(100, 0.0, 0, 0);
+  views[40].depth_agreement = 0.5;  // far below the drive's 0.9, as at a turn with true poses
+  EXPECT_FALSE(flagOutliers(views, times(100), {}).flagged[40]);
+  views[40].depth_agreement = 0.2;
+  EXPECT_TRUE(flagOutliers(views, times(100), {}).flagged[40]);
+}
+
+TEST(ImageConsistency, StretchesJoinAcrossOneUnflaggedView) {
+  const std::vector<bool> f = {false, true, true, false, true, false, false, true};
+  const auto s = flaggedStretches(f);
+  ASSERT_EQ(s.size(), 2U);
+  EXPECT_EQ(s[0].first, 1U);
+  EXPECT_EQ(s[0].last, 4U);
+  EXPECT_EQ(s[1].first, 7U);
+  EXPECT_EQ(s[1].last, 7U);
+  EXPECT_TRUE(flaggedStretches({false, false}).empty());
+}
+
+}  // namespace
+}  // namespace gvio::mapping
