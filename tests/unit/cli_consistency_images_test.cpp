@@ -66,31 +66,15 @@ std::string displaced(const fs::path& tum, double t0, double t1, const Eigen::Ve
   return out.str();
 }
 
+// Each test runs in a process of its own (ctest), so each does only what it needs, once: the
+// truth and the moved poses need no gvio run (a run folder is its report.json's sources and a
+// trajectory: the check rebuilds the map from them); the VIO's poses need one.
 class CliConsistencyImages : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new TempDir("cli_consistency_images");
     dataset_ = cachedSimulation(fmt::format(
         "--trajectory {}/assets/demo/drive.tum --seconds 20 --seed 9", GVIO_SOURCE_DIR));
-    const CommandResult r = runGvio(
-        fmt::format("run --dataset {} --out {} --no-progress --gnss off --set loops.enabled=false",
-                    quoted(dataset_), quoted(run("vio"))));
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    // Runs that differ only in their trajectory: the truth, and the truth with 10 s moved.
-    for (const char* name : {"truth", "fault"}) {
-      fs::create_directories(run(name));
-      for (const char* file : {"report.json", "config.yaml"}) {
-        fs::copy_file(run("vio") / file, run(name) / file);
-      }
-    }
-    fs::copy_file(dataset_ / "groundtruth.tum", run("truth") / "trajectory.tum");
-    writeText(run("fault") / "trajectory.tum",
-              displaced(dataset_ / "groundtruth.tum", kFaultFrom, kFaultTo, {0.0, 0.5, 0.0}));
-    for (const char* name : {"vio", "truth", "fault"}) {
-      const CommandResult c =
-          runGvio(fmt::format("consistency --run {} --images --no-progress", quoted(run(name))));
-      ASSERT_EQ(c.exit_code, 0) << name << ": " << c.err;
-    }
   }
   static void TearDownTestSuite() {
     delete dir_;
@@ -101,6 +85,44 @@ class CliConsistencyImages : public ::testing::Test {
   static nlohmann::json summary(const std::string& name) {
     return nlohmann::json::parse(readText(report(name) / "summary.json"));
   }
+  // A run folder of `trajectory_tum` (the text of a TUM file) over the simulated drive.
+  static void makeRun(const std::string& name, const std::string& trajectory_tum) {
+    fs::create_directories(run(name));
+    const nlohmann::json r = {{"mode", "stereo-imu"},
+                              {"sources",
+                               {{"dataset", fs::absolute(dataset_).string()},
+                                {"format", "kitti-raw"},
+                                {"calib_files", nlohmann::json::array()},
+                                {"gnss_file", nullptr}}}};
+    writeText(run(name) / "report.json", r.dump(2));
+    writeText(run(name) / "trajectory.tum", trajectory_tum);
+  }
+  static void check(const std::string& name) {
+    if (fs::exists(report(name) / "summary.json")) return;
+    const CommandResult c =
+        runGvio(fmt::format("consistency --run {} --images --no-progress", quoted(run(name))));
+    ASSERT_EQ(c.exit_code, 0) << name << ": " << c.err;
+  }
+  static void checkTruth() {
+    if (!fs::exists(run("truth"))) makeRun("truth", readText(dataset_ / "groundtruth.tum"));
+    check("truth");
+  }
+  static void checkFault() {
+    if (!fs::exists(run("fault"))) {
+      makeRun("fault",
+              displaced(dataset_ / "groundtruth.tum", kFaultFrom, kFaultTo, {0.0, 0.5, 0.0}));
+    }
+    check("fault");
+  }
+  static void checkVio() {
+    if (!fs::exists(run("vio"))) {
+      const CommandResult r = runGvio(fmt::format(
+          "run --dataset {} --out {} --no-progress --gnss off --set loops.enabled=false",
+          quoted(dataset_), quoted(run("vio"))));
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+    }
+    check("vio");
+  }
 
   static constexpr double kFaultFrom = 6.0, kFaultTo = 16.0;
   static TempDir* dir_;
@@ -109,7 +131,9 @@ class CliConsistencyImages : public ::testing::Test {
 TempDir* CliConsistencyImages::dir_ = nullptr;
 fs::path CliConsistencyImages::dataset_;
 
-TEST_F(CliConsistencyImages, WritesTheReportFiles) {
+// The truth is flagged nowhere (and every report file is there).
+TEST_F(CliConsistencyImages, TheTruePosesAreFlaggedNowhere) {
+  ASSERT_NO_FATAL_FAILURE(checkTruth());
   const nlohmann::json s = summary("truth");
   const std::size_t checked = s["keyframes"]["checked"].get<std::size_t>();
   EXPECT_GT(checked, 60U);  // 20 s at ~8 m/s, one map keyframe per 1.5 m
@@ -124,10 +148,6 @@ TEST_F(CliConsistencyImages, WritesTheReportFiles) {
   EXPECT_EQ(side.cols, 3 * 1241);  // recorded | rendered | difference
   EXPECT_EQ(side.rows, 376);
   EXPECT_GT(s["ms_per_keyframe"]["mean"].get<double>(), 0.0);
-}
-
-TEST_F(CliConsistencyImages, TheTruePosesAreFlaggedNowhere) {
-  const nlohmann::json s = summary("truth");
   EXPECT_EQ(s["keyframes"]["flagged"].get<int>(), 0);
   EXPECT_TRUE(s["flagged_stretches"].empty());
   EXPECT_GT(s["ncc"]["mean"].get<double>(), 0.5);
@@ -138,6 +158,8 @@ TEST_F(CliConsistencyImages, TheTruePosesAreFlaggedNowhere) {
 // unmoved one, seen by the keyframes whose view reaches across the stretch's ends (the camera
 // looks ahead up to 40 m, ~5 s at this speed). Keyframes elsewhere must not be flagged.
 TEST_F(CliConsistencyImages, PosesMovedHalfAMetreAreFlaggedAtThatStretchOnly) {
+  ASSERT_NO_FATAL_FAILURE(checkTruth());
+  ASSERT_NO_FATAL_FAILURE(checkFault());
   const auto rows = readRows(report("fault") / "keyframes.csv");
   std::size_t flagged = 0;
   for (const CsvRow& r : rows) {
@@ -164,6 +186,8 @@ TEST_F(CliConsistencyImages, PosesMovedHalfAMetreAreFlaggedAtThatStretchOnly) {
 }
 
 TEST_F(CliConsistencyImages, TheVioPosesScoreBelowTheTruePoses) {
+  ASSERT_NO_FATAL_FAILURE(checkTruth());
+  ASSERT_NO_FATAL_FAILURE(checkVio());
   const nlohmann::json vio = summary("vio"), truth = summary("truth");
   EXPECT_LT(vio["ncc"]["mean"].get<double>(), truth["ncc"]["mean"].get<double>());
   EXPECT_LT(vio["depth_agreement"]["mean"].get<double>(),
@@ -171,6 +195,7 @@ TEST_F(CliConsistencyImages, TheVioPosesScoreBelowTheTruePoses) {
 }
 
 TEST_F(CliConsistencyImages, OneKeyframeAtATimeAndBadRequests) {
+  if (!fs::exists(run("truth"))) makeRun("truth", readText(dataset_ / "groundtruth.tum"));
   const fs::path out = dir_->path() / "at";
   CommandResult r = runGvio(fmt::format("consistency --run {} --images --at 5 --worst 1 --out {}",
                                         quoted(run("truth")), quoted(out)));
