@@ -121,7 +121,7 @@ void checkFirstImageSizes(const Dataset& ds,
   for (std::size_t c = 0; c < ds.cameras.size() && c < calibration.size(); ++c) {
     if (c >= ds.frames.front().image_paths.size()) break;
     const std::filesystem::path& first = ds.frames.front().image_paths[c];
-    const cv::Mat image = cv::imread(first.string(), cv::IMREAD_GRAYSCALE);
+    const cv::Mat image = tryLoadGrayImage(first);
     const CameraModel& cam = ds.cameras[c];
     if (!image.empty() && (image.cols != cam.width_px || image.rows != cam.height_px)) {
       throw InputError(

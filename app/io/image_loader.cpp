@@ -49,6 +49,13 @@ std::string pngDefect(const std::vector<unsigned char>& bytes) {
   }
 }
 
+constexpr std::array<unsigned char, 3> kJpegSignature = {0xFF, 0xD8, 0xFF};
+
+template <std::size_t N>
+bool startsWith(const std::vector<unsigned char>& bytes, const std::array<unsigned char, N>& sig) {
+  return bytes.size() >= N && std::equal(sig.begin(), sig.end(), bytes.begin());
+}
+
 std::vector<unsigned char> readBytes(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary | std::ios::ate);
   if (!in) throw InputError(file, 0, "cannot open image file");
@@ -63,14 +70,34 @@ std::vector<unsigned char> readBytes(const std::filesystem::path& file) {
 
 }  // namespace
 
+cv::Mat decodeGrayPngOrJpeg(const std::vector<unsigned char>& bytes, std::string& defect) {
+  defect.clear();
+  if (startsWith(bytes, kPngSignature)) {
+    defect = pngDefect(bytes);
+  } else if (!startsWith(bytes, kJpegSignature)) {
+    defect =
+        bytes.empty() ? "empty" : "not a PNG or JPEG (its first bytes are neither's signature)";
+  }
+  if (!defect.empty()) return {};
+  cv::Mat image = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+  if (image.empty()) defect = "corrupt PNG/JPEG data";
+  return image;
+}
+
+cv::Mat tryLoadGrayImage(const std::filesystem::path& file) {
+  try {
+    std::string defect;
+    return decodeGrayPngOrJpeg(readBytes(file), defect);
+  } catch (const InputError&) {
+    return {};
+  }
+}
+
 cv::Mat loadGrayImage(const std::filesystem::path& file, const CameraModel& camera) {
   if (!std::filesystem::is_regular_file(file)) throw InputError(file, 0, "image file not found");
-  const std::vector<unsigned char> bytes = readBytes(file);
-  if (const std::string defect = pngDefect(bytes); !defect.empty()) {
-    throw InputError(file, 0, "unreadable image: " + defect);
-  }
-  cv::Mat image = bytes.empty() ? cv::Mat() : cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
-  if (image.empty()) throw InputError(file, 0, "unreadable image (corrupt or not a PNG/JPEG)");
+  std::string defect;
+  cv::Mat image = decodeGrayPngOrJpeg(readBytes(file), defect);
+  if (image.empty()) throw InputError(file, 0, "unreadable image: " + defect);
   if (image.cols != camera.width_px || image.rows != camera.height_px) {
     throw InputError(file, 0,
                      fmt::format("image is {}x{} but the calibration of {} says {}x{}", image.cols,

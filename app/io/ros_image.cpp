@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "io/image_loader.hpp"
 #include "odometry/error.hpp"
 
 namespace gvio::io {
@@ -70,8 +71,11 @@ cv::Mat compressedToGray(const bag::ImageMessage& m) {
     throw InvalidInput(fmt::format("compressed image format '{}' is not supported (png, jpeg)", f));
   }
   if (m.data.empty()) throw InvalidInput("compressed image without data");
-  cv::Mat gray = cv::imdecode(m.data, cv::IMREAD_GRAYSCALE);
-  if (gray.empty()) throw InvalidInput(fmt::format("compressed image ({}) cannot be decoded", f));
+  std::string defect;
+  cv::Mat gray = decodeGrayPngOrJpeg(m.data, defect);
+  if (gray.empty()) {
+    throw InvalidInput(fmt::format("compressed image ({}) cannot be decoded: {}", f, defect));
+  }
   return gray;
 }
 

@@ -116,7 +116,17 @@ TEST(RosImage, RefusalsSayWhatIsWrong) {
               HasSubstr("compressed image format '16UC1; compressedDepth png' is not"));
   bag::ImageMessage garbage = grayToRosImage(g, true);
   garbage.data.assign(40, 7);
-  EXPECT_THAT(error(garbage), HasSubstr("cannot be decoded"));
+  EXPECT_THAT(error(garbage), HasSubstr("cannot be decoded: not a PNG or JPEG"));
+  // Other formats never reach OpenCV, whose DICOM decoder (GDCM) aborted on this fuzzed message.
+  bag::ImageMessage dicom = grayToRosImage(g, true);
+  dicom.data.assign(128, 0);
+  const std::string tag = "DICM";
+  std::copy(tag.begin(), tag.end(), dicom.data.begin() + 128 - 4);
+  dicom.data.insert(dicom.data.end(), {'P', '1', '6', 'U', 'C', '1', 0, 0xC8, 0xDC});
+  EXPECT_THAT(error(dicom), HasSubstr("not a PNG or JPEG"));
+  bag::ImageMessage bmp = grayToRosImage(g, true);
+  cv::imencode(".bmp", g, bmp.data);  // BMP decodes in OpenCV, but is no ROS compressed format
+  EXPECT_THAT(error(bmp), HasSubstr("not a PNG or JPEG"));
   bag::ImageMessage empty = raw(g, "mono8");
   empty.width = 0;
   EXPECT_THAT(error(empty), HasSubstr("image of 0x6 pixels"));
