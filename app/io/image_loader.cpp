@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cstdint>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -26,6 +27,18 @@ std::uint32_t bigEndian32(const unsigned char* p) {
          std::uint32_t{p[3]};
 }
 
+// A chunk's 4-byte type as text: letters as they are (a valid type is 4 ASCII letters, PNG
+// specification section 5.4), anything else as \xNN, so an error quoting it stays one line.
+std::string chunkName(const unsigned char* p) {
+  std::string name;
+  for (int i = 0; i < 4; ++i) {
+    const unsigned char c = p[i];
+    name +=
+        std::isalpha(c) != 0 ? std::string(1, static_cast<char>(c)) : fmt::format("\\x{:02X}", c);
+  }
+  return name;
+}
+
 // libpng prints "libpng error: ..." on stderr before OpenCV reports a failed decode, so a damaged
 // PNG would add a stray line to the CLI's one-line error. Walks the chunk structure first
 // (lengths, CRCs, IEND) and returns what is wrong, or "" for a sound file or a non-PNG.
@@ -38,7 +51,7 @@ std::string pngDefect(const std::vector<unsigned char>& bytes) {
   while (true) {
     if (bytes.size() - pos < 12) return "truncated PNG (no IEND chunk)";
     const std::uint32_t length = bigEndian32(&bytes[pos]);
-    const std::string type(reinterpret_cast<const char*>(&bytes[pos + 4]), 4);
+    const std::string type = chunkName(&bytes[pos + 4]);
     if (length > bytes.size() - pos - 12) return "truncated PNG (ends inside chunk " + type + ")";
     const std::uint32_t crc = bigEndian32(&bytes[pos + 8 + length]);
     // The chunk CRC covers type and data (PNG specification, section 5.3): zlib's CRC-32.
