@@ -8,6 +8,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "mapping/consistency.hpp"
 #include "odometry/error.hpp"
 
 namespace gvio::mapping {
@@ -23,12 +24,9 @@ void requireSameSize(const cv::Mat& m, const cv::Mat& ref, int type, const char*
   }
 }
 
+// The median (mapping::percentile's), NaN without values.
 double median(std::vector<double> v) {
-  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  if (v.size() % 2 == 1) return *mid;
-  return 0.5 * (*mid + *std::max_element(v.begin(), mid));
+  return v.empty() ? std::numeric_limits<double>::quiet_NaN() : percentile(v, 0.5);
 }
 
 std::vector<double> finiteOf(const std::vector<double>& values) {

@@ -94,14 +94,19 @@ KeyframeTimings MapBuilder::addKeyframe(std::int64_t t_ns, const Eigen::Isometry
   return timings;
 }
 
+bool depthSpacingReached(const DenseMapConfig& dense, const Eigen::Isometry3d& T_last,
+                         const Eigen::Isometry3d& T_now) {
+  const Eigen::Isometry3d T_rel = T_last.inverse() * T_now;
+  const double moved_m = T_rel.translation().norm();
+  const double turned_deg = Eigen::AngleAxisd(T_rel.rotation()).angle() * 180.0 / M_PI;
+  return moved_m >= dense.min_spacing_m || turned_deg >= dense.min_rotation_deg;
+}
+
 bool MapBuilder::denseTurn(std::size_t index, const Eigen::Isometry3d& T_w_b) const {
   const DenseMapConfig& c = config_.dense;
   if (index % static_cast<std::size_t>(c.every_n_keyframes) != 0) return false;
   if (!last_dense_T_w_b_) return true;
-  const Eigen::Isometry3d T_last_b = last_dense_T_w_b_->inverse() * T_w_b;
-  const double moved_m = T_last_b.translation().norm();
-  const double turned_deg = Eigen::AngleAxisd(T_last_b.rotation()).angle() * 180.0 / M_PI;
-  return moved_m >= c.min_spacing_m || turned_deg >= c.min_rotation_deg;
+  return depthSpacingReached(c, *last_dense_T_w_b_, T_w_b);
 }
 
 bool MapBuilder::landmarkAccepted(const StoredLandmark& lm) const {

@@ -25,6 +25,13 @@
 
 namespace gvio::mapping {
 
+// The dense map's spacing rule: a keyframe at T_now gets stereo depth once the camera rig has moved
+// dense.min_spacing_m or turned dense.min_rotation_deg since T_last, the last keyframe with depth
+// (any frame, as long as both poses are in it). Also how `gvio consistency --images` chooses the
+// map's keyframes again.
+[[nodiscard]] bool depthSpacingReached(const DenseMapConfig& dense, const Eigen::Isometry3d& T_last,
+                                       const Eigen::Isometry3d& T_now);
+
 // T_target_b of the keyframe at t_ns, or nullopt when the target frame has no pose for it.
 using PoseLookup = std::function<std::optional<Eigen::Isometry3d>(std::int64_t t_ns)>;
 

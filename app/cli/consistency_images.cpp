@@ -17,6 +17,7 @@
 #include "io/image_loader.hpp"
 #include "io/input_error.hpp"
 #include "io/run_dir.hpp"
+#include "mapping/consistency.hpp"
 #include "odometry/error.hpp"
 #include "viz/camera_view.hpp"
 
@@ -59,12 +60,6 @@ double meanOf(const std::vector<double>& v) {
     ++n;
   }
   return n > 0 ? sum / static_cast<double>(n) : std::numeric_limits<double>::quiet_NaN();
-}
-
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
-  std::sort(v.begin(), v.end());
-  return v[static_cast<std::size_t>(std::floor(q * static_cast<double>(v.size() - 1)))];
 }
 
 // Worst first: flagged before unflagged, then by ZNCC (unscored last), then by depth agreement.
@@ -244,8 +239,8 @@ nlohmann::json summaryJson(const CheckResult& c, std::size_t map_keyframes,
                           {"flag_threshold", finiteOrNull(c.flags.depth.global)}};
   j["flagged_stretches"] = stretches;
   j["ms_per_keyframe"] = {{"mean", finiteOrNull(meanOf(ms))},
-                          {"median", finiteOrNull(quantile(ms, 0.5))},
-                          {"p90", finiteOrNull(quantile(ms, 0.9))}};
+                          {"median", mapping::percentile(ms, 0.5)},
+                          {"p90", mapping::percentile(ms, 0.9)}};
   j["options"] = {{"exclude_s", r.check.exclude_s},
                   {"neighbour_radius_m", r.check.neighbour_radius_m},
                   {"max_view_angle_deg", r.check.max_view_angle_deg},
@@ -277,12 +272,8 @@ int runImageConsistency(const ImageConsistencyRequest& r) {
   if (!fs::is_directory(fs::absolute(out).parent_path())) {
     throw io::InputError(out, 0, "output folder's parent does not exist");
   }
-  if (const auto warning = io::incompleteRunWarning(r.run)) spdlog::warn("{}", *warning);
-  io::RunReadOptions read;
-  read.cloud = read.occupancy = read.gnss_fixes = read.outages = read.loops = false;
-  const io::RunFiles run = io::readRunDir(r.run, read);
+  const io::RunFiles run = readMapRun(r.run, /*with_cloud=*/false);  // the check rebuilds the map
   const Trajectory& traj = viz::mapTrajectory(run);
-  if (!traj.hasTimestamps()) throw io::InputError(r.run, 0, "the trajectory has no timestamps");
   std::string mode;
   const io::Dataset ds = reopenRunDataset(r.run, r.dataset, mode);
   ConfigSources config;

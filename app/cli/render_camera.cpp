@@ -78,9 +78,10 @@ bool stereoMode(const fs::path& run_dir, const std::string& mode) {
 
 }  // namespace
 
-io::RunFiles readMapRun(const fs::path& run_dir) {
+io::RunFiles readMapRun(const fs::path& run_dir, bool with_cloud) {
   if (const auto warning = io::incompleteRunWarning(run_dir)) spdlog::warn("{}", *warning);
   io::RunReadOptions read;
+  read.cloud = with_cloud;
   read.occupancy = read.gnss_fixes = read.outages = read.loops = false;
   io::RunFiles run = io::readRunDir(run_dir, read);
   if (!viz::mapTrajectory(run).hasTimestamps()) {

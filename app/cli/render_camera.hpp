@@ -59,8 +59,8 @@ io::Dataset reopenRunDataset(const std::filesystem::path& run_dir,
                              const std::optional<std::filesystem::path>& dataset,
                              std::string& mode);
 
-// The run's trajectories and map.pcd (not the occupancy, fixes, outages or loops); warns when
-// the run did not complete. InputError when the trajectory has no timestamps.
-io::RunFiles readMapRun(const std::filesystem::path& run_dir);
+// The run's trajectories and (with_cloud) map.pcd, not the occupancy, fixes, outages or loops;
+// warns when the run did not complete. InputError when the trajectory has no timestamps.
+io::RunFiles readMapRun(const std::filesystem::path& run_dir, bool with_cloud = true);
 
 }  // namespace gvio::cli

@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "io/image_loader.hpp"
+#include "mapping/map_builder.hpp"
 #include "mapping/stereo_depth.hpp"
 #include "odometry/error.hpp"
 #include "odometry/rectifier.hpp"
@@ -42,10 +43,6 @@ struct KeyframeCloud {
   std::vector<Eigen::Vector3f> p_map;
   std::vector<std::uint8_t> grey;
 };
-
-double angleDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
-  return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle() * 180.0 / M_PI;
-}
 
 }  // namespace
 
@@ -106,12 +103,9 @@ void ImageCheck::State::selectKeyframes() {
     const std::int64_t t_ns = ds->frames[i].t_ns;
     const auto T_map_c = cameraPoseAt(*run, t_ns, T_b_c);
     if (!T_map_c) continue;
-    if (!keyframes.empty()) {
-      const Eigen::Isometry3d& last = keyframes.back().T_map_c;
-      const double moved = (T_map_c->translation() - last.translation()).norm();
-      if (moved < dense.min_spacing_m && angleDeg(last, *T_map_c) < dense.min_rotation_deg) {
-        continue;
-      }
+    if (!keyframes.empty() &&
+        !mapping::depthSpacingReached(dense, keyframes.back().T_map_c, *T_map_c)) {
+      continue;
     }
     keyframes.push_back({i, t_ns, *T_map_c});
   }
