@@ -15,6 +15,13 @@
 namespace gvio::odometry {
 namespace {
 
+// Weight w of the velocity at a frame's stamp, v = step + w (step - previous step), from two
+// backward differences over dt and dt_prev (their midpoints (dt + dt_prev) / 2 apart, the newer
+// dt / 2 before the stamp): linear extrapolation, exact for a constant image acceleration.
+double atStampWeight(double dt_s, double dt_prev_s) {
+  return dt_prev_s > 0.0 ? dt_s / (dt_s + dt_prev_s) : 0.0;
+}
+
 // Features this close to the image edge are dropped: their KLT window is mostly border padding,
 // and a feature about to leave the view is worth nothing to the estimator.
 constexpr float kBorderPx = 2.0F;
@@ -221,10 +228,19 @@ void FeatureTracker::trackPrevious(double dt_s, TrackerStats& stats) {
   std::vector<bool> ok = kltForwardBackward(prev_pyr_, left_pyr_, prev_px, cur_px, false, config_);
   for (std::size_t i = 0; i < ok.size(); ++i) {
     ok[i] = ok[i] && inside(cur_px[i], image_size_);
-    tracks_[i].velocity_pxps =
+    Track& t = tracks_[i];
+    const cv::Point2f step =
         dt_s > 0.0 ? (cur_px[i] - prev_px[i]) * static_cast<float>(1.0 / dt_s) : cv::Point2f();
-    tracks_[i].px = cur_px[i];
-    ++tracks_[i].length;
+    // A backward difference is the velocity half an interval ago; with the one before it, the
+    // velocity at the stamp to second order (constant image acceleration).
+    t.velocity_pxps = t.length > 1 && dt_s > 0.0
+                          ? step + (step - t.step_velocity_pxps) *
+                                       static_cast<float>(atStampWeight(dt_s, t.step_dt_s))
+                          : step;
+    t.step_velocity_pxps = step;
+    t.step_dt_s = dt_s;
+    t.px = cur_px[i];
+    ++t.length;
   }
   const auto before = tracks_.size();
   compact(tracks_, ok);
@@ -358,9 +374,18 @@ std::vector<Feature> FeatureTracker::matchStereo(TrackerStats& stats) {
                        std::abs(r.y - l.y) <= static_cast<float>(config_.stereo_max_vertical_px) &&
                        r.x <= l.x;
     Eigen::Vector2d velocity_right = toEigen(t.velocity_pxps);
-    if (match && t.has_disparity && t.length > 1 && dt_s_ > 0.0) {
-      velocity_right.x() -= static_cast<double>(l.x - r.x - t.disparity) / dt_s_;
+    const bool rate = match && t.has_disparity && t.length > 1 && dt_s_ > 0.0;
+    if (rate) {
+      const double step = static_cast<double>(l.x - r.x - t.disparity) / dt_s_;
+      const double at_stamp =
+          t.has_disparity_rate
+              ? step + (step - t.disparity_rate_pxps) * atStampWeight(dt_s_, t.disparity_rate_dt_s)
+              : step;
+      velocity_right.x() -= at_stamp;
+      t.disparity_rate_pxps = step;
+      t.disparity_rate_dt_s = dt_s_;
     }
+    t.has_disparity_rate = rate;
     t.has_disparity = match;
     t.disparity = match ? l.x - r.x : 0.0F;
     if (match) {

@@ -35,11 +35,15 @@ struct Feature {
   bool has_right = false;
   Eigen::Vector2d px_right = Eigen::Vector2d::Zero();  // valid when has_right
   int track_length = 1;  // frames this id has been seen in, this one included
-  // Image-plane velocity of the left pixel since the previous frame (px/s; zero for a new
-  // feature): the time-offset factors shift observations along it.
+  // Image-plane velocity of the left pixel at this frame (px/s; zero for a new feature): the
+  // backward difference since the previous frame, carried to this frame to second order with the
+  // one before it (a backward difference is the velocity half an interval earlier: at 10 Hz in a
+  // turn that lag put the time-offset correction pixels off). The time-offset factors shift
+  // observations along it.
   Eigen::Vector2d velocity_pxps = Eigen::Vector2d::Zero();
-  // The right pixel's: the left one's less the change of disparity (rectified rows), when the
-  // feature had a stereo match in the previous frame too; else the left one's.
+  // The right pixel's: the left one's less the rate of change of disparity (rectified rows, the
+  // same second-order estimate), when the feature had a stereo match in the previous frame too;
+  // else the left one's.
   Eigen::Vector2d velocity_right_pxps = Eigen::Vector2d::Zero();
 };
 
@@ -89,10 +93,17 @@ class FeatureTracker {
   struct Track {
     std::uint64_t id = 0;
     cv::Point2f px;
-    cv::Point2f velocity_pxps{0.0F, 0.0F};
+    cv::Point2f velocity_pxps{0.0F, 0.0F};  // at this frame's stamp (see Feature)
     int length = 1;
     bool has_disparity = false;
     float disparity = 0.0F;  // left x - right x in the frame it was measured, a stereo KLT guess
+    // The last backward differences and their intervals, for the second-order estimate at the
+    // stamp.
+    cv::Point2f step_velocity_pxps{0.0F, 0.0F};
+    double step_dt_s = 0.0;
+    bool has_disparity_rate = false;
+    double disparity_rate_pxps = 0.0;
+    double disparity_rate_dt_s = 0.0;
   };
 
   void checkImages(const cv::Mat& left, const cv::Mat& right) const;

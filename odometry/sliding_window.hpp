@@ -90,6 +90,12 @@ class SlidingWindow {
   // The camera-IMU time offset t_d (s; odometry/time_offset_factor.hpp), a state of IMU solves
   // when config.estimate_time_offset. It outlives clear(): a restart keeps the estimate.
   [[nodiscard]] double timeOffsetS() const { return *time_offset_s_; }
+  // Sets t_d (the initialisation's estimate); it becomes the prior's mean until the
+  // marginalisation prior holds t_d.
+  void setTimeOffsetS(double t_d_s) {
+    *time_offset_s_ = t_d_s;
+    time_offset_prior_mean_s_ = t_d_s;
+  }
 
  private:
   using FactorSink = std::function<void(std::shared_ptr<ceres::CostFunction>,

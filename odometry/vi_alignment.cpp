@@ -32,6 +32,7 @@ struct LinearLayout {
   int n = 0;
   bool refine = false;  // gravity as g0 + B w
   bool scale = false;
+  double t_d_s = 0.0;  // the visual positions are the body's t_d before the stamps
   [[nodiscard]] int gravityCols() const { return refine ? 2 : 3; }
   [[nodiscard]] int size() const { return 3 * n + gravityCols() + (scale ? 1 : 0); }
   [[nodiscard]] int gravityCol() const { return 3 * n; }
@@ -61,7 +62,9 @@ std::optional<LinearSolution> solveLinear(const std::vector<AlignmentFrame>& fra
     Eigen::Matrix3d G_v = -dt * Eigen::Matrix3d::Identity();
     y.head<3>() = -a.R_v_b * pre.deltaP();
     y.tail<3>() = a.R_v_b * pre.deltaV();
-    A.block<3, 3>(0, 3 * k) = dt * Eigen::Matrix3d::Identity();
+    // p(stamp) = p_visual + v t_d: the visual displacement misses (v_{k+1} - v_k) t_d.
+    A.block<3, 3>(0, 3 * k) = (dt + L.t_d_s) * Eigen::Matrix3d::Identity();
+    A.block<3, 3>(0, 3 * (k + 1)) = -L.t_d_s * Eigen::Matrix3d::Identity();
     A.block<3, 3>(3, 3 * k) = -Eigen::Matrix3d::Identity();
     A.block<3, 3>(3, 3 * (k + 1)) = Eigen::Matrix3d::Identity();
     if (L.refine) {
@@ -125,29 +128,126 @@ Eigen::Vector3d solveGyroBias(const std::vector<AlignmentFrame>& frames) {
   return lin.gyr + delta;
 }
 
+std::vector<Eigen::Vector3d> stampRates(const std::vector<AlignmentFrame>& frames) {
+  const std::size_t n = frames.size();
+  std::vector<Eigen::Vector3d> w(n, Eigen::Vector3d::Zero());
+  if (n < 2) return w;
+  // Mean rate over interval k (frames k-1 -> k), which is the rate at its midpoint to second
+  // order, and that midpoint's time relative to frame 0's stamp.
+  std::vector<Eigen::Vector3d> rate(n);
+  std::vector<double> mid(n, 0.0);
+  double t = 0.0;
+  for (std::size_t k = 1; k < n; ++k) {
+    const ImuPreintegration& pre = *frames[k].preintegration;
+    const double dt = std::max(pre.deltaT(), 1e-9);
+    rate[k] = logSo3(pre.deltaR()) / dt;
+    mid[k] = t + 0.5 * dt;
+    t += dt;
+  }
+  if (n == 2) return {rate[1], rate[1]};
+  // Linear in time through the two nearest midpoints (extrapolated at the ends).
+  auto at = [&](std::size_t a, double time) {
+    const double w1 = (time - mid[a]) / (mid[a + 1] - mid[a]);
+    return Eigen::Vector3d((1.0 - w1) * rate[a] + w1 * rate[a + 1]);
+  };
+  t = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (k > 0) t += frames[k].preintegration->deltaT();
+    const std::size_t a = std::clamp<std::size_t>(k, 1, n - 2);
+    w[k] = at(a, t);
+  }
+  return w;
+}
+
+GyroBiasTimeOffset solveGyroBiasAndTimeOffset(const std::vector<AlignmentFrame>& frames,
+                                              const TimeOffsetPrior& prior) {
+  GyroBiasTimeOffset out;
+  out.t_d_s = prior.mean_s;
+  out.t_d_sigma_s = prior.sigma_s;
+  const std::vector<Eigen::Vector3d> w = stampRates(frames);
+  using Mat4 = Eigen::Matrix4d;
+  using Vec4 = Eigen::Vector4d;
+  Mat4 H = Mat4::Zero();
+  Vec4 g = Vec4::Zero();
+  double ete = 0.0;
+  for (std::size_t k = 1; k < frames.size(); ++k) {
+    const ImuPreintegration& pre = *frames[k].preintegration;
+    const Eigen::Matrix3d R_ij = frames[k - 1].R_v_b.transpose() * frames[k].R_v_b;
+    // The residual at the prior's t_d; the unknowns are the bias change and t_d - prior mean.
+    Eigen::Matrix<double, 3, 4> A;
+    A.leftCols<3>() = pre.dR_dbg();
+    A.col(3) = pre.deltaR().transpose() * w[k - 1] - w[k];
+    const Eigen::Vector3d e = logSo3(pre.deltaR().transpose() * R_ij) - A.col(3) * prior.mean_s;
+    H += A.transpose() * A;
+    g += A.transpose() * e;
+    ete += e.squaredNorm();
+  }
+  const ImuBias& lin =
+      frames.size() > 1 ? frames[1].preintegration->linearizationBias() : ImuBias{};
+  const int rows = 3 * (static_cast<int>(frames.size()) - 1);
+  const Eigen::LDLT<Mat4> ldlt(H + Mat4::Identity() * 1e-12 * std::max(1.0, H.trace()));
+  const Vec4 x_ls = ldlt.solve(g);
+  if (rows <= 4 || !x_ls.allFinite()) {
+    out.gyr_bias = solveGyroBias(frames);
+    return out;
+  }
+  // Residual variance of the unweighted fit; a floor keeps exact data from claiming infinite
+  // precision (0.1 mrad per interval: well below any camera's rotation noise).
+  const double ssr = std::max(0.0, ete - 2.0 * x_ls.dot(g) + x_ls.dot(H * x_ls));
+  const double variance = std::max(ssr / (rows - 4), 1e-8);
+  // MAP with the prior on t_d: (H / s^2 + P) x = g / s^2 (x(3) relative to the prior mean).
+  Mat4 Hp = H / variance;
+  Hp(3, 3) += 1.0 / (prior.sigma_s * prior.sigma_s);
+  const Eigen::LDLT<Mat4> post(Hp);
+  const Vec4 x = post.solve(g / variance);
+  if (!x.allFinite()) {
+    out.gyr_bias = solveGyroBias(frames);
+    return out;
+  }
+  out.t_d_sigma_s = std::sqrt(std::max(0.0, post.solve(Vec4::UnitW())(3)));
+  out.observed = out.t_d_sigma_s <= prior.max_sigma_s;
+  if (!out.observed) {
+    out.gyr_bias = solveGyroBias(frames);
+    return out;
+  }
+  out.gyr_bias = lin.gyr + x.head<3>();
+  out.t_d_s = prior.mean_s + x(3);
+  return out;
+}
+
 Eigen::Matrix3d gravityAlignment(const Eigen::Vector3d& g_v) {
   return Eigen::Quaterniond::FromTwoVectors(g_v.normalized(), Eigen::Vector3d(0, 0, -1))
       .toRotationMatrix();
 }
 
-std::optional<AlignmentResult> alignVisualInertial(std::vector<AlignmentFrame>& frames,
-                                                   bool estimate_scale, double gravity_tolerance,
-                                                   double max_scale_rel_sigma) {
+std::optional<AlignmentResult> alignVisualInertial(
+    std::vector<AlignmentFrame>& frames, bool estimate_scale, double gravity_tolerance,
+    double max_scale_rel_sigma, const std::optional<TimeOffsetPrior>& time_offset) {
   if (frames.size() < 3) return std::nullopt;
   for (std::size_t k = 1; k < frames.size(); ++k) {
     if (!frames[k].preintegration) return std::nullopt;
   }
   AlignmentResult result;
-  result.gyr_bias = solveGyroBias(frames);
+  if (time_offset) {
+    const GyroBiasTimeOffset solved = solveGyroBiasAndTimeOffset(frames, *time_offset);
+    result.gyr_bias = solved.gyr_bias;
+    result.t_d_s = solved.t_d_s;
+    result.t_d_sigma_s = solved.t_d_sigma_s;
+    result.t_d_observed = solved.observed;
+  } else {
+    result.gyr_bias = solveGyroBias(frames);
+  }
   for (std::size_t k = 1; k < frames.size(); ++k) {
     ImuBias bias = frames[k].preintegration->linearizationBias();
     bias.gyr = result.gyr_bias;
     frames[k].preintegration->reintegrate(bias);
   }
+  if (time_offset) result.w_b = stampRates(frames);  // at the solved bias
 
   LinearLayout L;
   L.n = static_cast<int>(frames.size());
   L.scale = estimate_scale;
+  L.t_d_s = result.t_d_s;
   const Eigen::Matrix<double, 3, 2> unused = Eigen::Matrix<double, 3, 2>::Zero();
   auto sol = solveLinear(frames, L, Eigen::Vector3d::Zero(), unused);
   if (!sol) return std::nullopt;

@@ -34,20 +34,59 @@ struct AlignmentResult {
   double scale_rel_sigma = 0.0;                   // 1-sigma of the scale / scale (if estimated)
   Eigen::Matrix3d R_w_v = Eigen::Matrix3d::Identity();  // visual frame -> gravity-aligned world
   double gravity_norm_before_refinement = 0.0;
+  // Camera-IMU time offset (when asked for): how much the frames' stamps lag the exposures the
+  // visual poses belong to (s), and its posterior 1-sigma.
+  double t_d_s = 0.0;
+  double t_d_sigma_s = 0.0;
+  bool t_d_observed = false;
+  std::vector<Eigen::Vector3d> w_b;  // body rate at each stamp (rad/s), when t_d was estimated
+};
+
+// A Gaussian prior on the camera-IMU time offset t_d (s): stamps = exposures + t_d.
+struct TimeOffsetPrior {
+  double mean_s = 0.0;
+  double sigma_s = 0.05;
+  // The window's estimate is taken only when its posterior 1-sigma is below this; else t_d stays
+  // at the prior's mean (a straight drive at constant speed says nothing about t_d, and a weakly
+  // informed estimate moved it by 5-17 ms on such drives).
+  double max_sigma_s = 0.005;
+};
+
+struct GyroBiasTimeOffset {
+  Eigen::Vector3d gyr_bias = Eigen::Vector3d::Zero();
+  double t_d_s = 0.0;
+  double t_d_sigma_s = 0.0;  // posterior 1-sigma of the joint solve
+  bool observed = false;     // t_d_sigma_s <= max_sigma_s: t_d_s is the window's estimate
 };
 
 // Least-squares gyroscope bias from the visual relative rotations (VINS-Mono eq. 15).
 Eigen::Vector3d solveGyroBias(const std::vector<AlignmentFrame>& frames);
+
+// The gyroscope bias and the camera-IMU time offset together (Qin and Shen, IROS 2018, moved into
+// the initialisation): the visual poses belong to the exposures, t_d before the stamps the IMU was
+// preintegrated between, so to first order in t_d and the bias change
+//   Log(dR_ij(bg)^T R_i^T R_j) = dR_dbg dbg + (dR_ij^T w_i - w_j) t_d
+// with w the body rate at each stamp (from the preintegrated rotations). Residual noise is taken
+// from the fit itself (unit weights, as the velocity solve); needs >= 3 frames. A window that does
+// not observe t_d (no change of rotation rate) gives the prior's mean and solveGyroBias's bias.
+GyroBiasTimeOffset solveGyroBiasAndTimeOffset(const std::vector<AlignmentFrame>& frames,
+                                              const TimeOffsetPrior& prior);
+
+// Body angular rate (rad/s) at each frame's stamp, interpolated between the mean rates of the
+// preintegrated intervals around it (their midpoints), extrapolated at the window's ends.
+std::vector<Eigen::Vector3d> stampRates(const std::vector<AlignmentFrame>& frames);
 
 // Full alignment; re-integrates the preintegrations at the solved gyroscope bias. Returns nullopt
 // when the linear problem is degenerate, the gravity estimate is implausible (|g| off by more
 // than `gravity_tolerance` relative) or, when estimating the scale, its relative 1-sigma (normal
 // equations inverse times the residual variance) exceeds `max_scale_rel_sigma`: at constant
 // velocity the scale is unobservable, and a wrong scale is worse than waiting for more motion.
-std::optional<AlignmentResult> alignVisualInertial(std::vector<AlignmentFrame>& frames,
-                                                   bool estimate_scale,
-                                                   double gravity_tolerance = 0.1,
-                                                   double max_scale_rel_sigma = 0.05);
+// With `time_offset`, t_d is estimated with the gyroscope bias (solveGyroBiasAndTimeOffset) and
+// the velocity solve takes each visual position as the body's t_d before its stamp.
+std::optional<AlignmentResult> alignVisualInertial(
+    std::vector<AlignmentFrame>& frames, bool estimate_scale, double gravity_tolerance = 0.1,
+    double max_scale_rel_sigma = 0.05,
+    const std::optional<TimeOffsetPrior>& time_offset = std::nullopt);
 
 // Rotation that takes the gravity direction g_v to (0, 0, -|g|) with no added yaw about it.
 Eigen::Matrix3d gravityAlignment(const Eigen::Vector3d& g_v);

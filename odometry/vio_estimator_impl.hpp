@@ -8,6 +8,7 @@
 #include "odometry/feature_tracker.hpp"
 #include "odometry/imu_buffer.hpp"
 #include "odometry/sliding_window.hpp"
+#include "odometry/vi_alignment.hpp"
 #include "odometry/vio_estimator.hpp"
 
 namespace gvio::odometry {
@@ -57,6 +58,10 @@ struct VioEstimator::Impl {
   bool staticInitialize(std::int64_t t_ns, const TrackedFrame& tracked);
   bool motionInitialize(std::int64_t t_ns);
   bool monoInitialize(std::int64_t t_ns);
+  // The prior on t_d for the initialisation when the window estimates it (else none).
+  [[nodiscard]] std::optional<TimeOffsetPrior> timeOffsetPrior() const;
+  // Moves the window's poses from the exposures to the stamps by the alignment's t_d.
+  void moveToStamps(const AlignmentResult& result);
   void reportWaiting(std::int64_t t_ns, const std::string& why);
   void applyAlignment(const Eigen::Matrix3d& R_w_v, const std::vector<Eigen::Vector3d>& v_v,
                       const ImuBias& bias);

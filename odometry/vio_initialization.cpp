@@ -9,6 +9,7 @@
 #include <map>
 #include <string>
 
+#include "odometry/lie.hpp"
 #include "odometry/mono_sfm.hpp"
 #include "odometry/vi_alignment.hpp"
 #include "odometry/vio_estimator_impl.hpp"
@@ -29,7 +30,33 @@ std::string fmt3(double v) {
   return buf;
 }
 
+// What the alignment reports about t_d, when it estimated it.
+std::string timeOffsetText(const std::optional<TimeOffsetPrior>& prior,
+                           const AlignmentResult& result) {
+  if (!prior) return "";
+  if (!result.t_d_observed) {
+    return ", time offset not observed by the window (+- " + fmt3(result.t_d_sigma_s * 1e3) +
+           " ms): kept at " + fmt3(result.t_d_s * 1e3) + " ms";
+  }
+  return ", time offset " + fmt3(result.t_d_s * 1e3) + " +- " + fmt3(result.t_d_sigma_s * 1e3) +
+         " ms";
+}
+
 }  // namespace
+
+void VioEstimator::Impl::moveToStamps(const AlignmentResult& result) {
+  // The vision-only window placed each body where it was at the exposure, t_d before the stamp
+  // the IMU belongs to: carry it forward by its velocity and rate (first order in t_d).
+  if (result.w_b.empty() || result.t_d_s == 0.0) return;
+  auto& frames = window.frames();
+  for (std::size_t k = 0; k < frames.size() && k < result.w_b.size(); ++k) {
+    const Eigen::Isometry3d T = frames[k]->T_w_b();
+    Eigen::Isometry3d T_stamp = Eigen::Isometry3d::Identity();
+    T_stamp.linear() = normalizeRotation(T.linear() * expSo3(result.w_b[k] * result.t_d_s));
+    T_stamp.translation() = T.translation() + result.v_v[k] * result.t_d_s;
+    poseToBlock(T_stamp, frames[k]->pose.data());
+  }
+}
 
 void VioEstimator::Impl::applyAlignment(const Eigen::Matrix3d& R_w_v,
                                         const std::vector<Eigen::Vector3d>& v_v,
@@ -106,18 +133,22 @@ bool VioEstimator::Impl::motionInitialize(std::int64_t t_ns) {
     if (k > 0) a.preintegration = frames[k]->preintegration;
     af.push_back(a);
   }
-  const auto result = alignVisualInertial(af, false);
+  const std::optional<TimeOffsetPrior> t_d_prior = timeOffsetPrior();
+  const auto result = alignVisualInertial(af, false, 0.1, 0.05, t_d_prior);
   if (!result) {
     reportWaiting(t_ns, "visual-inertial alignment not yet well conditioned: waiting");
     return false;
   }
   ImuBias bias;
   bias.gyr = result->gyr_bias;
+  if (t_d_prior) window.setTimeOffsetS(result->t_d_s);
+  moveToStamps(*result);
   applyAlignment(result->R_w_v, result->v_v, bias);
   event(t_ns, "initialized",
         "visual-inertial alignment over " + std::to_string(frames.size()) +
             " frames: |g| before refinement " + fmt3(result->gravity_norm_before_refinement) +
-            " m/s^2, gyro bias " + fmt3(bias.gyr.norm() * 180.0 / M_PI) + " deg/s");
+            " m/s^2, gyro bias " + fmt3(bias.gyr.norm() * 180.0 / M_PI) + " deg/s" +
+            timeOffsetText(t_d_prior, *result));
   return true;
 }
 
@@ -169,7 +200,8 @@ bool VioEstimator::Impl::monoInitialize(std::int64_t t_ns) {
     af[k].lever_v = T_v_c.rotation() * T_c_b.translation();
     if (k > 0) af[k].preintegration = frames[k]->preintegration;
   }
-  const auto result = alignVisualInertial(af, true);
+  const std::optional<TimeOffsetPrior> t_d_prior = timeOffsetPrior();
+  const auto result = alignVisualInertial(af, true, 0.1, 0.05, t_d_prior);
   if (!result) {
     reportWaiting(t_ns,
                   "mono+IMU: scale not yet observable (SfM solved, alignment waits for "
@@ -198,14 +230,22 @@ bool VioEstimator::Impl::monoInitialize(std::int64_t t_ns) {
   }
   ImuBias bias;
   bias.gyr = result->gyr_bias;
+  if (t_d_prior) window.setTimeOffsetS(result->t_d_s);
+  moveToStamps(*result);
   applyAlignment(result->R_w_v, result->v_v, bias);
   event(t_ns, "initialized",
         "mono SfM (" + std::to_string(sfm->points_v.size()) + " points, " + fmt3(sfm->rms_px) +
             " px rms) + visual-inertial alignment over " + std::to_string(frames.size()) +
             " frames: scale " + fmt3(s) + " (+-" + fmt3(100.0 * result->scale_rel_sigma) +
             " %), |g| before refinement " + fmt3(result->gravity_norm_before_refinement) +
-            " m/s^2");
+            " m/s^2" + timeOffsetText(t_d_prior, *result));
   return true;
+}
+
+std::optional<TimeOffsetPrior> VioEstimator::Impl::timeOffsetPrior() const {
+  if (!config.estimate_time_offset) return std::nullopt;
+  // Around the current value (the calibration's, or the estimate kept through a restart).
+  return TimeOffsetPrior{window.timeOffsetS(), config.time_offset_sigma_s};
 }
 
 bool VioEstimator::Impl::tryInitialize(std::int64_t t_ns, const TrackedFrame& tracked) {

@@ -94,8 +94,10 @@ TEST(CliTimeOffset, AnExcitedDriveEstimatesTheLagAndRecoversTheTrajectory) {
   const auto on = run("on", true);
   const double ape_off = off["evaluation"]["ape_se3"]["rmse"].get<double>();
   const double ape_on = on["evaluation"]["ape_se3"]["rmse"].get<double>();
-  // Measured: 2.92 m off, 0.38 m on; t_d 17.0 ms (13.0 ms after 1 s, then 17.0-18.3 ms).
-  EXPECT_LT(ape_on, 0.25 * ape_off) << ape_on << " vs " << ape_off;
+  // Measured (2026-11-27): 2.34 m off, 0.24 m on; the initialisation's t_d 20.5 +- 0.5 ms, then
+  // 12.4 ms after 1 s, 16.8-19.4 ms later, 17.9 ms at the end. (Before the initialisation
+  // estimated t_d and the tracker's velocities were carried to the stamp: 2.92 m / 0.38 m.)
+  EXPECT_LT(ape_on, 0.15 * ape_off) << ape_on << " vs " << ape_off;
   EXPECT_NEAR(on["time_offset"]["t_d_s"].get<double>(), 0.02, 0.005);
   for (const auto& entry : on["time_offset"]["history"]) {
     if (entry[0].get<double>() - on["time_offset"]["history"][0][0].get<double>() < 2.0) continue;

@@ -206,11 +206,18 @@ TEST_F(FeatureTrackerTest, TracksAgreeWithTheTrueMotion) {
 // Image velocities (for the camera-IMU time offset): a tracked feature's is its displacement
 // since the previous frame over the stamps' difference, left and right (the right one along x from
 // the change of disparity, along y the left one's: rectified rows); a new feature's is zero.
-TEST_F(FeatureTrackerTest, VelocitiesAreTheDisplacementSinceThePreviousFrame) {
-  int checked = 0, checked_right = 0, fresh = 0;
+// A feature's velocity is its backward difference since the previous frame, carried to this
+// frame with the difference before it (constant image acceleration), once it has one; the right
+// pixel's is the left one's less the rate of disparity, estimated the same way.
+TEST_F(FeatureTrackerTest, VelocitiesAreTheBackwardDifferencesCarriedToTheFrame) {
+  int checked = 0, extrapolated = 0, checked_right = 0, fresh = 0;
   for (std::size_t k = 1; k < tracked_.size(); ++k) {
     const double dt_s = 1e-9 * static_cast<double>(tracked_[k].t_ns - tracked_[k - 1].t_ns);
+    const double dt_prev_s =
+        k >= 2 ? 1e-9 * static_cast<double>(tracked_[k - 1].t_ns - tracked_[k - 2].t_ns) : 0.0;
+    const double w = dt_s / (dt_s + dt_prev_s);
     const auto previous = byId(tracked_[k - 1]);
+    const auto before = k >= 2 ? byId(tracked_[k - 2]) : decltype(previous){};
     for (const Feature& f : tracked_[k].features) {
       const auto it = previous.find(f.id);
       if (it == previous.end()) {
@@ -218,19 +225,31 @@ TEST_F(FeatureTrackerTest, VelocitiesAreTheDisplacementSinceThePreviousFrame) {
         ++fresh;
         continue;
       }
-      const Eigen::Vector2d expected = (f.px_left - it->second.px_left) / dt_s;
+      const Feature& p = it->second;
+      const auto bt = before.find(f.id);
+      const Eigen::Vector2d step = (f.px_left - p.px_left) / dt_s;
+      Eigen::Vector2d expected = step;
+      if (bt != before.end()) {
+        expected += (step - (p.px_left - bt->second.px_left) / dt_prev_s) * w;
+        ++extrapolated;
+      }
       EXPECT_LT((f.velocity_pxps - expected).norm(), 1e-3 * std::max(1.0, expected.norm()));
       ++checked;
-      if (f.has_right && it->second.has_right) {
-        const double expected_right_x = (f.px_right.x() - it->second.px_right.x()) / dt_s;
-        EXPECT_NEAR(f.velocity_right_pxps.x(), expected_right_x,
-                    1e-3 * std::max(1.0, std::abs(expected_right_x)));
+      if (f.has_right && p.has_right) {
+        const auto disparity = [](const Feature& x) { return x.px_left.x() - x.px_right.x(); };
+        double rate = (disparity(f) - disparity(p)) / dt_s;
+        if (bt != before.end() && bt->second.has_right) {
+          rate += (rate - (disparity(p) - disparity(bt->second)) / dt_prev_s) * w;
+        }
+        EXPECT_NEAR(f.velocity_right_pxps.x(), f.velocity_pxps.x() - rate,
+                    1e-3 * std::max(1.0, std::abs(rate)));
         EXPECT_EQ(f.velocity_right_pxps.y(), f.velocity_pxps.y());
         ++checked_right;
       }
     }
   }
   EXPECT_GT(checked, 1000);
+  EXPECT_GT(extrapolated, 1000);
   EXPECT_GT(checked_right, 1000);
   EXPECT_GT(fresh, 0);
 }
