@@ -38,12 +38,23 @@ bool LandmarkMap::observe(std::uint64_t id, const Observation& obs) {
   auto it = landmarks_.find(id);
   if (it == landmarks_.end()) return false;
   std::vector<Observation>& seen = it->second.observations;
-  // A feature detected in its anchor frame has no image velocity there yet: it takes the one it
-  // shows next (its displacement to the next frame), which the time-offset factors need for the
-  // anchor's bearing too.
-  if (seen.size() == 1 && seen.front().velocity_pxps.isZero(0.0)) {
-    seen.front().velocity_pxps = obs.velocity_pxps;
-    seen.front().velocity_right_pxps = obs.velocity_right_pxps;
+  Observation& anchor = seen.front();
+  if (seen.size() == 1 && anchor.velocity_pxps.isZero(0.0)) {
+    // A feature detected in its anchor frame has no image velocity there yet: it takes the one it
+    // shows next (its displacement to the next frame), which the time-offset factors need for the
+    // anchor's bearing too. That is the velocity half way to the next frame...
+    anchor.velocity_pxps = obs.velocity_pxps;
+    anchor.velocity_right_pxps = obs.velocity_right_pxps;
+    anchor.velocity_from_t_ns = obs.t_ns;
+  } else if (anchor.velocity_from_t_ns > anchor.t_ns && obs.t_ns > anchor.velocity_from_t_ns) {
+    // ... carried back to the anchor's stamp through the next velocity (the tracker's estimate at
+    // its frame): a constant image acceleration, as the tracker assumes.
+    const double mid = 0.5 * static_cast<double>(anchor.t_ns + anchor.velocity_from_t_ns);
+    const double w =
+        (mid - static_cast<double>(anchor.t_ns)) / (static_cast<double>(obs.t_ns) - mid);
+    anchor.velocity_pxps -= w * (obs.velocity_pxps - anchor.velocity_pxps);
+    anchor.velocity_right_pxps -= w * (obs.velocity_right_pxps - anchor.velocity_right_pxps);
+    anchor.velocity_from_t_ns = -1;
   }
   seen.push_back(obs);
   return true;

@@ -20,6 +20,10 @@ struct Observation {
   Eigen::Vector2d px_right = Eigen::Vector2d::Zero();
   Eigen::Vector2d velocity_pxps = Eigen::Vector2d::Zero();        // left image, px/s (tracker's)
   Eigen::Vector2d velocity_right_pxps = Eigen::Vector2d::Zero();  // right image
+  std::int64_t t_ns = 0;                                          // the frame's stamp
+  // >= 0 while the velocities are provisional: a feature new in this frame took the backward
+  // difference it showed at the frame stamped here, i.e. its velocity half way there.
+  std::int64_t velocity_from_t_ns = -1;
 
   // Where the feature is at the frame's stamp when the stamps lag the exposures by t_d (s): the
   // first-order shift z + t_d V of the time-offset factors (Qin and Shen 2018). Every geometric

@@ -150,6 +150,7 @@ void VioEstimator::Impl::addObservations(const WindowFrame& f, const TrackedFram
   for (const Feature& feat : tracked.features) {
     Observation o;
     o.frame_uid = f.uid;
+    o.t_ns = f.t_ns;
     o.px_left = feat.px_left;
     o.has_right = geometry.stereo && feat.has_right;
     o.px_right = feat.px_right;

@@ -110,5 +110,39 @@ TEST_F(LandmarkReprojection, ObservationsAreMeasuredAtTheStampsForTheTimeOffset)
   EXPECT_EQ(rejected(0.0), 1);
 }
 
+// A feature new in its anchor frame has no velocity there: it takes the backward difference it
+// shows at the next frame (the velocity half way there) and, at the frame after, is carried back
+// to its own stamp through the tracker's velocity there (constant acceleration: exact for a
+// velocity linear in time).
+TEST(LandmarkVelocities, ANewFeatureGetsItsVelocityCarriedBackToItsAnchor) {
+  const auto velocity = [](double t_s) {
+    return Eigen::Vector2d(100.0 + 400.0 * t_s, -20.0 - 150.0 * t_s);
+  };
+  const auto observation = [](std::uint64_t uid, std::int64_t t_ns, const Eigen::Vector2d& v) {
+    Observation o;
+    o.frame_uid = uid;
+    o.t_ns = t_ns;
+    o.px_left = Eigen::Vector2d(300.0, 200.0);
+    o.velocity_pxps = v;
+    o.velocity_right_pxps = v - Eigen::Vector2d(3.0, 0.0);
+    return o;
+  };
+  LandmarkMap map;
+  map.create(7, observation(1, 0, Eigen::Vector2d::Zero()), StereoGeometry{}, 0.5, 100.0);
+  // The tracker's backward difference at 0.1 s is the velocity at 0.05 s.
+  ASSERT_TRUE(map.observe(7, observation(2, 100'000'000, velocity(0.05))));
+  const auto anchor = [&map] { return map.all().at(7).observations.front(); };
+  EXPECT_EQ(anchor().velocity_pxps, velocity(0.05));  // provisional
+  EXPECT_EQ(anchor().velocity_from_t_ns, 100'000'000);
+  ASSERT_TRUE(map.observe(7, observation(3, 200'000'000, velocity(0.2))));
+  EXPECT_LT((anchor().velocity_pxps - velocity(0.0)).norm(), 1e-9);
+  EXPECT_LT((anchor().velocity_right_pxps - (velocity(0.0) - Eigen::Vector2d(3.0, 0.0))).norm(),
+            1e-9);
+  EXPECT_EQ(anchor().velocity_from_t_ns, -1);
+  // Final: later observations leave it alone.
+  ASSERT_TRUE(map.observe(7, observation(4, 300'000'000, velocity(5.0))));
+  EXPECT_LT((anchor().velocity_pxps - velocity(0.0)).norm(), 1e-9);
+}
+
 }  // namespace
 }  // namespace gvio::odometry
