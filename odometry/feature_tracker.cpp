@@ -231,12 +231,10 @@ void FeatureTracker::trackPrevious(double dt_s, TrackerStats& stats) {
     Track& t = tracks_[i];
     const cv::Point2f step =
         dt_s > 0.0 ? (cur_px[i] - prev_px[i]) * static_cast<float>(1.0 / dt_s) : cv::Point2f();
-    // A backward difference is the velocity half an interval ago; with the one before it, the
-    // velocity at the stamp to second order (constant image acceleration).
-    t.velocity_pxps = t.length > 1 && dt_s > 0.0
-                          ? step + (step - t.step_velocity_pxps) *
-                                       static_cast<float>(atStampWeight(dt_s, t.step_dt_s))
-                          : step;
+    // A backward difference is the velocity half an interval ago; with the one before it (none
+    // yet for a new track: step_dt_s 0), the velocity at the stamp to second order.
+    t.velocity_pxps =
+        step + (step - t.step_velocity_pxps) * static_cast<float>(atStampWeight(dt_s, t.step_dt_s));
     t.step_velocity_pxps = step;
     t.step_dt_s = dt_s;
     t.px = cur_px[i];
@@ -374,18 +372,15 @@ std::vector<Feature> FeatureTracker::matchStereo(TrackerStats& stats) {
                        std::abs(r.y - l.y) <= static_cast<float>(config_.stereo_max_vertical_px) &&
                        r.x <= l.x;
     Eigen::Vector2d velocity_right = toEigen(t.velocity_pxps);
-    const bool rate = match && t.has_disparity && t.length > 1 && dt_s_ > 0.0;
-    if (rate) {
+    if (match && t.has_disparity && t.length > 1 && dt_s_ > 0.0) {
       const double step = static_cast<double>(l.x - r.x - t.disparity) / dt_s_;
-      const double at_stamp =
-          t.has_disparity_rate
-              ? step + (step - t.disparity_rate_pxps) * atStampWeight(dt_s_, t.disparity_rate_dt_s)
-              : step;
-      velocity_right.x() -= at_stamp;
+      velocity_right.x() -=
+          step + (step - t.disparity_rate_pxps) * atStampWeight(dt_s_, t.disparity_rate_dt_s);
       t.disparity_rate_pxps = step;
       t.disparity_rate_dt_s = dt_s_;
+    } else {
+      t.disparity_rate_dt_s = 0.0;  // no rate in this frame: the next one starts afresh
     }
-    t.has_disparity_rate = rate;
     t.has_disparity = match;
     t.disparity = match ? l.x - r.x : 0.0F;
     if (match) {

@@ -97,11 +97,10 @@ class FeatureTracker {
     int length = 1;
     bool has_disparity = false;
     float disparity = 0.0F;  // left x - right x in the frame it was measured, a stereo KLT guess
-    // The last backward differences and their intervals, for the second-order estimate at the
-    // stamp.
+    // The last backward differences and their intervals (0: none), for the second-order
+    // estimate at the stamp.
     cv::Point2f step_velocity_pxps{0.0F, 0.0F};
     double step_dt_s = 0.0;
-    bool has_disparity_rate = false;
     double disparity_rate_pxps = 0.0;
     double disparity_rate_dt_s = 0.0;
   };
