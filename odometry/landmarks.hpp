@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "odometry/reprojection_factor.hpp"
+#include "odometry/time_offset_factor.hpp"
 
 namespace gvio::odometry {
 
@@ -24,16 +25,27 @@ struct Observation {
   // >= 0 while the velocities are provisional: a feature new in this frame took the backward
   // difference it showed at the frame stamped here, i.e. its velocity half way there.
   std::int64_t velocity_from_t_ns = -1;
+  // The t_d (s) its frame's state was re-timed by: the state belongs to the stamp minus this
+  // (WindowFrame::retime_ns), so only the rest of t_d is left to the pixel's motion.
+  double t_d_base_s = 0.0;
 
-  // Where the feature is at the frame's stamp when the stamps lag the exposures by t_d (s): the
-  // first-order shift z + t_d V of the time-offset factors (Qin and Shen 2018). Every geometric
-  // use of an observation (triangulation, outlier test, re-anchoring) must see the same pixel as
-  // the solver, or it rejects exactly the fast-moving features that make t_d observable.
+  // Where the feature is at its frame's state time when the stamps lag the exposures by t_d (s):
+  // the first-order shift z + (t_d - t_d_base) V of the time-offset factors (Qin and Shen 2018).
+  // Every geometric use of an observation (triangulation, outlier test, re-anchoring) must see the
+  // same pixel as the solver, or it rejects exactly the fast-moving features that make t_d
+  // observable.
   [[nodiscard]] Eigen::Vector2d leftAt(double t_d_s) const {
-    return px_left + t_d_s * velocity_pxps;
+    return px_left + (t_d_s - t_d_base_s) * velocity_pxps;
   }
   [[nodiscard]] Eigen::Vector2d rightAt(double t_d_s) const {
-    return px_right + t_d_s * velocity_right_pxps;
+    return px_right + (t_d_s - t_d_base_s) * velocity_right_pxps;
+  }
+  // The same as the factors take it: pixel at t_d = 0 and velocity (z(t_d) = px + t_d V).
+  [[nodiscard]] MovingPixel movingLeft() const {
+    return {px_left - t_d_base_s * velocity_pxps, velocity_pxps};
+  }
+  [[nodiscard]] MovingPixel movingRight() const {
+    return {px_right - t_d_base_s * velocity_right_pxps, velocity_right_pxps};
   }
 };
 

@@ -119,11 +119,10 @@ void SlidingWindow::timeOffsetFactors(Landmark& lm, WindowFrame& anchor,
   const double sigma = config_.pixel_sigma_px;
   const ceres::LossFunction* loss = huber_.get();
   const Observation& a = lm.anchor();
-  const MovingPixel anchor_px{a.px_left, a.velocity_pxps};
+  const MovingPixel anchor_px = a.movingLeft();
   if (geometry_.stereo && a.has_right) {
     sink(std::make_shared<SameFrameTimeOffsetFactor>(anchor_px, geometry_.left, geometry_.right,
-                                                     MovingPixel{a.px_right, a.velocity_right_pxps},
-                                                     sigma),
+                                                     a.movingRight(), sigma),
          loss, {&lm.inv_depth, t_d});
   }
   double* anchor_pose = anchor.pose.data();
@@ -132,13 +131,11 @@ void SlidingWindow::timeOffsetFactors(Landmark& lm, WindowFrame& anchor,
     WindowFrame* f = find(o.frame_uid);
     if (f == nullptr || f == &anchor) continue;
     sink(std::make_shared<ReprojectionTimeOffsetFactor>(anchor_px, geometry_.left, geometry_.left,
-                                                        MovingPixel{o.px_left, o.velocity_pxps},
-                                                        sigma),
+                                                        o.movingLeft(), sigma),
          loss, {anchor_pose, f->pose.data(), &lm.inv_depth, t_d});
     if (geometry_.stereo && o.has_right) {
-      sink(std::make_shared<ReprojectionTimeOffsetFactor>(
-               anchor_px, geometry_.left, geometry_.right,
-               MovingPixel{o.px_right, o.velocity_right_pxps}, sigma),
+      sink(std::make_shared<ReprojectionTimeOffsetFactor>(anchor_px, geometry_.left,
+                                                          geometry_.right, o.movingRight(), sigma),
            loss, {anchor_pose, f->pose.data(), &lm.inv_depth, t_d});
     }
   }

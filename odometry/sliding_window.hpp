@@ -22,7 +22,12 @@ namespace gvio::odometry {
 
 struct WindowFrame {
   std::uint64_t uid = 0;
-  std::int64_t t_ns = 0;
+  std::int64_t t_ns = 0;  // the image stamp
+  // With the time offset estimated, the state (pose, velocity, IMU preintegration) belongs to the
+  // exposure as t_d was estimated when the frame came, t_ns - retime_ns (VINS-Fusion's re-timing),
+  // and the factors move its pixels by the rest of t_d only: the first-order pixel motion then
+  // covers a correction near zero instead of the whole offset. 0 without estimation.
+  std::int64_t retime_ns = 0;
   bool keyframe = false;
   std::array<double, 7> pose{0, 0, 0, 1, 0, 0, 0};  // PoseManifold layout
   std::array<double, 9> speed_bias{};               // v_w, b_acc, b_gyr
@@ -30,6 +35,7 @@ struct WindowFrame {
   // across an IMU outage.
   std::shared_ptr<ImuPreintegration> preintegration;
 
+  [[nodiscard]] std::int64_t stateNs() const { return t_ns - retime_ns; }
   [[nodiscard]] Eigen::Isometry3d T_w_b() const { return poseFromBlock(pose.data()); }
   [[nodiscard]] Eigen::Map<Eigen::Vector3d> velocity() {
     return Eigen::Map<Eigen::Vector3d>(speed_bias.data());

@@ -151,6 +151,7 @@ void VioEstimator::Impl::addObservations(const WindowFrame& f, const TrackedFram
     Observation o;
     o.frame_uid = f.uid;
     o.t_ns = f.t_ns;
+    o.t_d_base_s = static_cast<double>(f.retime_ns) * 1e-9;
     o.px_left = feat.px_left;
     o.has_right = geometry.stereo && feat.has_right;
     o.px_right = feat.px_right;
@@ -209,7 +210,8 @@ FrameResult VioEstimator::Impl::process(std::int64_t t_ns, const TrackedFrame& t
   }
 
   if (latest.valid && (!usesImu(config.mode) || imu_aligned) &&
-      !plausibleMotion(latest.T_w_b, f.T_w_b(), static_cast<double>(t_ns - latest.t_ns) * 1e-9)) {
+      !plausibleMotion(latest.T_w_b, f.T_w_b(),
+                       static_cast<double>(f.stateNs() - latest.t_ns) * 1e-9)) {
     // Never hand out a jump: drop the frame's solve and go on from the latest estimate.
     window.dropNewest();
     restart(t_ns, "lost", "implausible motion estimate: restarting the window", imuActive());
@@ -218,8 +220,9 @@ FrameResult VioEstimator::Impl::process(std::int64_t t_ns, const TrackedFrame& t
   FrameResult r;
   r.t_ns = t_ns;
   r.initialized = !usesImu(config.mode) || imu_aligned;
-  r.T_w_b = f.T_w_b();
-  r.v_w_mps = f.velocity();
+  const LatestState at_stamp = atStamp(f);
+  r.T_w_b = at_stamp.T_w_b;
+  r.v_w_mps = at_stamp.v_w;
   r.bias = f.bias();
   r.keyframe = f.keyframe;
   r.features = static_cast<int>(tracked.features.size());
@@ -231,7 +234,7 @@ FrameResult VioEstimator::Impl::process(std::int64_t t_ns, const TrackedFrame& t
 void VioEstimator::Impl::finishFrame(const WindowFrame& f) {
   if (latest.valid) previous_pose = latest.T_w_b;
   latest.valid = true;
-  latest.t_ns = f.t_ns;
+  latest.t_ns = f.stateNs();
   latest.T_w_b = f.T_w_b();
   latest.v_w = Eigen::Map<const Eigen::Vector3d>(f.speed_bias.data());
   latest.bias = f.bias();
@@ -243,7 +246,7 @@ void VioEstimator::Impl::finishFrame(const WindowFrame& f) {
   }
   // IMU still needed: from the newest window frame on, and the static-detection interval.
   std::int64_t keep = latest.t_ns - static_cast<std::int64_t>(config.init_window_s * 1e9);
-  if (!window.frames().empty()) keep = std::min(keep, window.frames().back()->t_ns);
+  if (!window.frames().empty()) keep = std::min(keep, window.frames().back()->stateNs());
   imu.dropBefore(std::min(keep, latest.t_ns));
 }
 

@@ -35,7 +35,14 @@ struct VioEstimator::Impl {
   bool checkTime(std::int64_t t_ns);
   FrameResult coast(std::int64_t t_ns, const std::string& why);
   std::unique_ptr<WindowFrame> predictFrame(std::int64_t t_ns, const TrackedFrame& tracked);
-  std::optional<Eigen::Isometry3d> predictVisual(const TrackedFrame& tracked) const;
+  // How far before its stamp a new frame's state is placed (WindowFrame::retime_ns).
+  [[nodiscard]] std::int64_t retimeNs(std::int64_t t_ns) const;
+  // The state carried to to_ns on the IMU (which must cover the interval).
+  [[nodiscard]] LatestState propagate(const LatestState& from, std::int64_t to_ns) const;
+  // The result of a solved window frame, at its stamp.
+  [[nodiscard]] LatestState atStamp(const WindowFrame& f) const;
+  std::optional<Eigen::Isometry3d> predictVisual(const TrackedFrame& tracked,
+                                                 std::int64_t retime_ns) const;
   bool isKeyframe(const WindowFrame& f, const TrackedFrame& tracked) const;
   // The features of `tracked` that are window landmarks seen in frame `frame_uid`, and their mean
   // image motion since then (keyframe parallax, static detection).
@@ -60,6 +67,9 @@ struct VioEstimator::Impl {
   bool monoInitialize(std::int64_t t_ns);
   // The prior on t_d for the initialisation when the window estimates it (else none).
   [[nodiscard]] std::optional<TimeOffsetPrior> timeOffsetPrior() const;
+  // The re-timing of the window's frames (WindowFrame::retime_ns, s), the same for all of them
+  // during the initialisation.
+  [[nodiscard]] double windowRetimeS() const;
   // Moves the window's poses from the exposures to the stamps by the alignment's t_d.
   void moveToStamps(const AlignmentResult& result);
   void reportWaiting(std::int64_t t_ns, const std::string& why);

@@ -30,23 +30,25 @@ std::string fmt3(double v) {
   return buf;
 }
 
-// What the alignment reports about t_d, when it estimated it.
+// What the alignment reports about t_d, when it estimated it (relative to the window's re-timing
+// base_s).
 std::string timeOffsetText(const std::optional<TimeOffsetPrior>& prior,
-                           const AlignmentResult& result) {
+                           const AlignmentResult& result, double base_s) {
   if (!prior) return "";
+  const double t_d_s = base_s + result.t_d_s;
   if (!result.t_d_observed) {
     return ", time offset not observed by the window (+- " + fmt3(result.t_d_sigma_s * 1e3) +
-           " ms): kept at " + fmt3(result.t_d_s * 1e3) + " ms";
+           " ms): kept at " + fmt3(t_d_s * 1e3) + " ms";
   }
-  return ", time offset " + fmt3(result.t_d_s * 1e3) + " +- " + fmt3(result.t_d_sigma_s * 1e3) +
-         " ms";
+  return ", time offset " + fmt3(t_d_s * 1e3) + " +- " + fmt3(result.t_d_sigma_s * 1e3) + " ms";
 }
 
 }  // namespace
 
 void VioEstimator::Impl::moveToStamps(const AlignmentResult& result) {
-  // The vision-only window placed each body where it was at the exposure, t_d before the stamp
-  // the IMU belongs to: carry it forward by its velocity and rate (first order in t_d).
+  // The vision-only window placed each body where it was at the exposure, result.t_d_s (relative
+  // to the window's re-timing) before the state time the IMU belongs to: carry it forward by its
+  // velocity and rate (first order in t_d).
   if (result.w_b.empty() || result.t_d_s == 0.0) return;
   auto& frames = window.frames();
   for (std::size_t k = 0; k < frames.size() && k < result.w_b.size(); ++k) {
@@ -141,14 +143,14 @@ bool VioEstimator::Impl::motionInitialize(std::int64_t t_ns) {
   }
   ImuBias bias;
   bias.gyr = result->gyr_bias;
-  if (t_d_prior) window.setTimeOffsetS(result->t_d_s);
   moveToStamps(*result);
+  if (t_d_prior) window.setTimeOffsetS(windowRetimeS() + result->t_d_s);
   applyAlignment(result->R_w_v, result->v_v, bias);
   event(t_ns, "initialized",
         "visual-inertial alignment over " + std::to_string(frames.size()) +
             " frames: |g| before refinement " + fmt3(result->gravity_norm_before_refinement) +
             " m/s^2, gyro bias " + fmt3(bias.gyr.norm() * 180.0 / M_PI) + " deg/s" +
-            timeOffsetText(t_d_prior, *result));
+            timeOffsetText(t_d_prior, *result, windowRetimeS()));
   return true;
 }
 
@@ -230,22 +232,33 @@ bool VioEstimator::Impl::monoInitialize(std::int64_t t_ns) {
   }
   ImuBias bias;
   bias.gyr = result->gyr_bias;
-  if (t_d_prior) window.setTimeOffsetS(result->t_d_s);
   moveToStamps(*result);
+  if (t_d_prior) window.setTimeOffsetS(windowRetimeS() + result->t_d_s);
   applyAlignment(result->R_w_v, result->v_v, bias);
   event(t_ns, "initialized",
         "mono SfM (" + std::to_string(sfm->points_v.size()) + " points, " + fmt3(sfm->rms_px) +
             " px rms) + visual-inertial alignment over " + std::to_string(frames.size()) +
             " frames: scale " + fmt3(s) + " (+-" + fmt3(100.0 * result->scale_rel_sigma) +
             " %), |g| before refinement " + fmt3(result->gravity_norm_before_refinement) +
-            " m/s^2" + timeOffsetText(t_d_prior, *result));
+            " m/s^2" + timeOffsetText(t_d_prior, *result, windowRetimeS()));
   return true;
+}
+
+double VioEstimator::Impl::windowRetimeS() const {
+  const auto& frames = window.frames();
+  return frames.empty() ? 0.0 : static_cast<double>(frames.front()->retime_ns) * 1e-9;
 }
 
 std::optional<TimeOffsetPrior> VioEstimator::Impl::timeOffsetPrior() const {
   if (!config.estimate_time_offset) return std::nullopt;
+  // The alignment sees t_d relative to the re-timing, which t_d does not change before it: every
+  // frame of the window has the same one (else no estimate; the window's own solve goes on).
+  const auto& frames = window.frames();
+  for (const auto& f : frames) {
+    if (f->retime_ns != frames.front()->retime_ns) return std::nullopt;
+  }
   // Around the current value (the calibration's, or the estimate kept through a restart).
-  return TimeOffsetPrior{window.timeOffsetS(), config.time_offset_sigma_s};
+  return TimeOffsetPrior{window.timeOffsetS() - windowRetimeS(), config.time_offset_sigma_s};
 }
 
 bool VioEstimator::Impl::tryInitialize(std::int64_t t_ns, const TrackedFrame& tracked) {

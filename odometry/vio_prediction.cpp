@@ -66,8 +66,8 @@ FrameResult VioEstimator::Impl::coast(std::int64_t t_ns, const std::string& why)
   return r;
 }
 
-std::optional<Eigen::Isometry3d> VioEstimator::Impl::predictVisual(
-    const TrackedFrame& tracked) const {
+std::optional<Eigen::Isometry3d> VioEstimator::Impl::predictVisual(const TrackedFrame& tracked,
+                                                                   std::int64_t retime_ns) const {
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   const PoseLookup poses = window.poseLookup();
@@ -79,7 +79,9 @@ std::optional<Eigen::Isometry3d> VioEstimator::Impl::predictVisual(
     if (anchor == nullptr) continue;
     const Eigen::Vector3d p_w = LandmarkMap::worldPoint(it->second, anchor, geometry, t_d);
     object.emplace_back(p_w.x(), p_w.y(), p_w.z());
-    const Eigen::Vector2d px = f.px_left + t_d * f.velocity_pxps;  // at the stamp
+    // At the state's time, the stamp less retime_ns.
+    const Eigen::Vector2d px =
+        f.px_left + (t_d - static_cast<double>(retime_ns) * 1e-9) * f.velocity_pxps;
     image.emplace_back(px.x(), px.y());
   }
   if (object.size() < static_cast<std::size_t>(kMinPnpPoints) || !latest.valid) return std::nullopt;
@@ -100,44 +102,77 @@ std::optional<Eigen::Isometry3d> VioEstimator::Impl::predictVisual(
   return plausibleMotion(latest.T_w_b, pnp, guess_dt_s) ? pnp : guess;
 }
 
+std::int64_t VioEstimator::Impl::retimeNs(std::int64_t t_ns) const {
+  if (!config.estimate_time_offset || !usesImu(config.mode)) return 0;
+  // The IMU has arrived up to the stamp, not beyond: a negative t_d stays with the pixel motion.
+  auto r = static_cast<std::int64_t>(std::llround(std::max(0.0, window.timeOffsetS()) * 1e9));
+  // The states stay in time order whatever t_d does.
+  const auto& frames = window.frames();
+  if (!frames.empty()) r = std::min(r, t_ns - frames.back()->stateNs() - 1);
+  if (latest.valid) r = std::min(r, t_ns - latest.t_ns - 1);
+  return std::max<std::int64_t>(r, 0);
+}
+
+LatestState VioEstimator::Impl::propagate(const LatestState& from, std::int64_t to_ns) const {
+  // IMU propagation of a state (Forster eq. 33).
+  auto pre = imu.preintegrate(from.t_ns, to_ns, from.bias, config.imu_noise);
+  const Eigen::Vector3d g(0, 0, -kGravity_mps2);
+  const double dt = pre->deltaT();
+  const Eigen::Matrix3d R = from.T_w_b.rotation();
+  LatestState to = from;
+  to.t_ns = to_ns;
+  to.T_w_b.linear() = R * pre->deltaR();
+  to.T_w_b.translation() =
+      from.T_w_b.translation() + from.v_w * dt + 0.5 * g * dt * dt + R * pre->deltaP();
+  to.v_w = from.v_w + g * dt + R * pre->deltaV();
+  return to;
+}
+
+LatestState VioEstimator::Impl::atStamp(const WindowFrame& f) const {
+  LatestState s;
+  s.valid = true;
+  s.t_ns = f.stateNs();
+  s.T_w_b = f.T_w_b();
+  s.v_w = Eigen::Map<const Eigen::Vector3d>(f.speed_bias.data());
+  s.bias = f.bias();
+  const auto max_hold = static_cast<std::int64_t>(config.max_imu_gap_s * 1e9);
+  if (f.retime_ns == 0 || !imuActive() || !imu.covers(s.t_ns, f.t_ns, max_hold)) return s;
+  return propagate(s, f.t_ns);
+}
+
 std::unique_ptr<WindowFrame> VioEstimator::Impl::predictFrame(std::int64_t t_ns,
                                                               const TrackedFrame& tracked) {
   auto f = std::make_unique<WindowFrame>();
   f->uid = next_uid++;
   f->t_ns = t_ns;
+  f->retime_ns = retimeNs(t_ns);
+  const std::int64_t state_ns = f->stateNs();
   const auto max_hold = static_cast<std::int64_t>(config.max_imu_gap_s * 1e9);
   const auto& frames = window.frames();
-  if (usesImu(config.mode) && !frames.empty() && imu.covers(frames.back()->t_ns, t_ns, max_hold)) {
-    const double gap = imu.largestGapS(frames.back()->t_ns, t_ns);
+  if (usesImu(config.mode) && !frames.empty() &&
+      imu.covers(frames.back()->stateNs(), state_ns, max_hold)) {
+    const double gap = imu.largestGapS(frames.back()->stateNs(), state_ns);
     if (gap > config.max_imu_gap_s) {
       ++counters.imu_gaps;
       event(t_ns, "imu_gap", "IMU gap of " + std::to_string(gap) + " s bridged by interpolation");
     }
-    f->preintegration =
-        imu.preintegrate(frames.back()->t_ns, t_ns, frames.back()->bias(), config.imu_noise);
+    f->preintegration = imu.preintegrate(frames.back()->stateNs(), state_ns, frames.back()->bias(),
+                                         config.imu_noise);
   } else if (usesImu(config.mode) && !frames.empty()) {
     ++counters.imu_gaps;
     event(t_ns, "imu_gap", "no IMU data up to this frame: visual constraints only");
   }
 
-  if (imuActive() && latest.valid && imu.covers(latest.t_ns, t_ns, max_hold)) {
-    // IMU propagation of the latest state (Forster eq. 33).
-    auto pre = imu.preintegrate(latest.t_ns, t_ns, latest.bias, config.imu_noise);
-    const Eigen::Vector3d g(0, 0, -kGravity_mps2);
-    const double dt = pre->deltaT();
-    const Eigen::Matrix3d R = latest.T_w_b.rotation();
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = R * pre->deltaR();
-    T.translation() =
-        latest.T_w_b.translation() + latest.v_w * dt + 0.5 * g * dt * dt + R * pre->deltaP();
-    poseToBlock(T, f->pose.data());
-    f->velocity() = latest.v_w + g * dt + R * pre->deltaV();
+  if (imuActive() && latest.valid && imu.covers(latest.t_ns, state_ns, max_hold)) {
+    const LatestState s = propagate(latest, state_ns);
+    poseToBlock(s.T_w_b, f->pose.data());
+    f->velocity() = s.v_w;
     f->setBias(latest.bias);
     return f;
   }
   Eigen::Isometry3d T = latest.valid ? latest.T_w_b : Eigen::Isometry3d::Identity();
   if (latest.valid) {
-    if (auto visual = predictVisual(tracked)) T = *visual;
+    if (auto visual = predictVisual(tracked, f->retime_ns)) T = *visual;
   }
   poseToBlock(T, f->pose.data());
   f->velocity() = latest.valid ? latest.v_w : Eigen::Vector3d::Zero();

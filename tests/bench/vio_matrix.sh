@@ -14,6 +14,7 @@
 # and the IMU noise drawn per drive in BENCH_IMU_RANGE (MIN:MAX, default 0.5:2; the estimator
 # assumes imu.*: KITTI's oxts cannot state the drive's noise) and, with BENCH_TURN_ON (ACC:GYR,
 # 1-sigma per axis in m/s^2 and rad/s; default none), turn-on biases drawn per drive.
+# BENCH_SET ("key=value ...") adds `--set` overrides to every run (compare a setting on the matrix).
 #
 #   tests/bench/vio_matrix.sh                                   # 5 styles x 3 seeds x 3 modes
 #   BENCH_STYLES="street open_road" BENCH_SEEDS="1 2" BENCH_SECONDS=30 tests/bench/vio_matrix.sh
@@ -33,6 +34,8 @@ IMU_RANGE="${BENCH_IMU_RANGE:-0.5:2}"
 TURN_ON="${BENCH_TURN_ON:-}"
 TURN_ON_SET=()
 TURN_ON_TAG=""
+RUN_SET=()
+for kv in ${BENCH_SET:-}; do RUN_SET+=(--set "$kv"); done
 if [ -n "$TURN_ON" ]; then
   IFS=: read -r TURN_ACC TURN_GYR <<< "$TURN_ON"
   if [ -z "${TURN_ACC:-}" ] || [ -z "${TURN_GYR:-}" ]; then
@@ -143,7 +146,8 @@ if [ -z "${BENCH_TABLE_ONLY:-}" ]; then
         echo "bench: $style seed $seed $mode" >&2
         run_rc=0
         "$GVIO" run --dataset "$cache" --gnss off --set "vio.mode=$mode" --set map.enabled=false \
-          --set loops.enabled=false --out "$run" --no-progress > "$run/run.log" 2>&1 || run_rc=$?
+          --set loops.enabled=false ${RUN_SET[@]+"${RUN_SET[@]}"} --out "$run" --no-progress \
+          > "$run/run.log" 2>&1 || run_rc=$?
         eval_rc=-1
         if [ "$run_rc" -eq 0 ] && [ -s "$run/trajectory_vio.tum" ]; then
           eval_rc=0

@@ -144,5 +144,27 @@ TEST(LandmarkVelocities, ANewFeatureGetsItsVelocityCarriedBackToItsAnchor) {
   EXPECT_LT((anchor().velocity_pxps - velocity(0.0)).norm(), 1e-9);
 }
 
+// A frame re-timed by t_d_base (its state at the stamp less that) leaves only t_d - t_d_base to the
+// pixel's motion, and the factors' form (px + t_d V) must give the same pixel as leftAt.
+TEST(LandmarkVelocities, AReTimedObservationMovesByTheRestOfTheOffset) {
+  Observation o;
+  o.px_left = Eigen::Vector2d(300.0, 200.0);
+  o.px_right = Eigen::Vector2d(280.0, 200.0);
+  o.velocity_pxps = Eigen::Vector2d(120.0, -40.0);
+  o.velocity_right_pxps = Eigen::Vector2d(110.0, -40.0);
+  o.t_d_base_s = 0.018;
+  EXPECT_LT((o.leftAt(0.018) - o.px_left).norm(), 1e-12);  // the state is at the estimate
+  EXPECT_LT((o.leftAt(0.020) - Eigen::Vector2d(300.24, 199.92)).norm(), 1e-9);
+  EXPECT_LT((o.rightAt(0.010) - Eigen::Vector2d(279.12, 200.32)).norm(), 1e-9);
+  for (const double t_d : {-0.01, 0.0, 0.018, 0.05}) {
+    const MovingPixel left = o.movingLeft();
+    const MovingPixel right = o.movingRight();
+    EXPECT_LT((left.px + t_d * left.velocity_pxps - o.leftAt(t_d)).norm(), 1e-9) << t_d;
+    EXPECT_LT((right.px + t_d * right.velocity_pxps - o.rightAt(t_d)).norm(), 1e-9) << t_d;
+  }
+  o.t_d_base_s = 0.0;  // not re-timed: the pixel itself
+  EXPECT_EQ(o.movingLeft().px, o.px_left);
+}
+
 }  // namespace
 }  // namespace gvio::odometry
