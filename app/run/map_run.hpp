@@ -59,10 +59,21 @@ struct MapRunResult {
   nlohmann::json las;           // report.json's map "las": written, file, points, CRS, or why not
 };
 
-// The poses the map is built with: the fused trajectory's (T_enu_b, interpolated at the keyframe
-// stamps) when `fused` is given and not empty, else the keyframes' VIO poses (T_w_b). Refers to
-// `recorder` and `fused`: use it while they live.
-mapping::PoseLookup mapPoses(const MapRecorder& recorder, const Trajectory* fused);
+// Where the map's poses come from: the final trajectory (fused and/or loop-closed) when not null
+// and not empty, else the VIO's; and how late the images' stamps are against their exposures
+// (the camera-IMU time offset t_d the VIO estimated, s; 0 when it did not).
+struct MapPoseSource {
+  const Trajectory* fused = nullptr;
+  const Trajectory* vio = nullptr;
+  double exposure_lag_s = 0.0;
+};
+
+// The poses the map is built with, the body's at each keyframe's exposure: the fused trajectory's
+// (T_enu_b) when there is one, else the VIO's (T_w_b), interpolated at the keyframe's stamp less
+// exposure_lag_s (at the stamp itself where that falls outside the trajectory). Without a lag:
+// the fused trajectory at the stamps, else the keyframes' own VIO poses. Refers to `recorder` and
+// the trajectories: use it while they live.
+mapping::PoseLookup mapPoses(const MapRecorder& recorder, const MapPoseSource& source);
 
 // Builds the map with mapPoses() and writes it to `out`, each file atomically, in an order that
 // bounds memory on a long drive: the clouds first (sparse landmarks + dense points, merged into
@@ -77,9 +88,9 @@ mapping::PoseLookup mapPoses(const MapRecorder& recorder, const Trajectory* fuse
 // `alongside`: read-only looks at the keyframes (revisits, --two-pass) that need their dense
 // points; it runs first. `threaded`: the occupancy is built on a thread of its own while the
 // cloud files are written (nothing freed until it is done); the files are the same either way.
-MapRunResult buildAndWriteMap(MapRecorder& recorder, const Trajectory* fused, bool georeferenced,
-                              const std::filesystem::path& out, bool threaded = false,
-                              const std::function<void()>& alongside = {});
+MapRunResult buildAndWriteMap(MapRecorder& recorder, const MapPoseSource& source,
+                              bool georeferenced, const std::filesystem::path& out,
+                              bool threaded = false, const std::function<void()>& alongside = {});
 
 // report.json's "map": frame, counts, per-keyframe cost of each stage (ms mean/p95/max), memory.
 nlohmann::json mapReport(const MapRecorder& recorder, const MapRunResult& result);

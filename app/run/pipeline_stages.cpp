@@ -151,7 +151,9 @@ void runMapStage(RunState& s) {
     }
     return;
   }
-  const Trajectory* poses = s.final_trajectory.empty() ? nullptr : &s.final_trajectory;
+  const MapPoseSource poses{s.final_trajectory.empty() ? nullptr : &s.final_trajectory,
+                            &s.vio.trajectory,
+                            s.vio.time_offset_estimated ? s.vio.time_offset_s : 0.0};
   // Before the build frees the keyframes' dense points (beside the occupancy when threaded).
   nlohmann::json two_pass_report, revisits;
   const auto looks = [&] {

@@ -39,21 +39,24 @@ TEST(CliTimeOffset, KalibrTimeshiftUndoesALaggingCameraAndTheEstimateIsReported)
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return nlohmann::json::parse(test::readText(dir.path() / out / "report.json"));
   };
+  // The estimate is on by default.
   const auto sync = run(synced, "zero.yaml", "sync");
-  const auto ignored = run(lagging, "zero.yaml", "ignored");
+  const auto ignored = run(lagging, "zero.yaml", "ignored", "--set vio.estimate_time_offset=false");
   const auto shifted = run(lagging, "shift.yaml", "shifted");
-  const double ape_sync = sync["evaluation"]["ape_se3"]["rmse"].get<double>();
-  const double ape_ignored = ignored["evaluation"]["ape_se3"]["rmse"].get<double>();
-  EXPECT_GT(ape_ignored, 1.3 * ape_sync) << ape_sync;
+  const auto estimated = run(lagging, "zero.yaml", "estimated");
+  const auto ape = [](const nlohmann::json& report) {
+    return report["evaluation"]["ape_se3"]["rmse"].get<double>();
+  };
+  // Measured (2026-11-27): synchronised 0.176 m, lagging 0.235 m unestimated, 0.169 m estimated.
+  EXPECT_GT(ape(ignored), 1.3 * ape(estimated)) << ape(estimated);
+  EXPECT_LT(ape(estimated), 1.1 * ape(sync)) << ape(sync);  // the 10 %
   // The stamps moved back by the shift are the exposures: the synchronised run, bit for bit.
   EXPECT_EQ(test::readText(dir.path() / "shifted" / "trajectory_vio.tum"),
             test::readText(dir.path() / "sync" / "trajectory_vio.tum"));
   EXPECT_DOUBLE_EQ(shifted["time_offset"]["calibration_timeshift_cam_imu_s"].get<double>(), -0.02);
-  EXPECT_FALSE(shifted["time_offset"]["estimated"].get<bool>());  // off by default
-  EXPECT_EQ(shifted["time_offset"]["t_d_s"].get<double>(), 0.0);
+  EXPECT_FALSE(ignored["time_offset"]["estimated"].get<bool>());
+  EXPECT_EQ(ignored["time_offset"]["t_d_s"].get<double>(), 0.0);
 
-  const auto estimated =
-      run(lagging, "zero.yaml", "estimated", "--set vio.estimate_time_offset=true");
   const auto& t = estimated["time_offset"];
   EXPECT_TRUE(t["estimated"].get<bool>());
   EXPECT_GE(t["history"].size(), 8U);  // one value per second once initialised
