@@ -32,7 +32,8 @@ SlidingWindow::SlidingWindow(const EstimatorConfig& config, const StereoGeometry
     : config_(config),
       geometry_(geometry),
       huber_(std::make_shared<ceres::HuberLoss>(config.huber_sigmas)),
-      context_(ceres::Context::Create()) {}
+      context_(ceres::Context::Create()),
+      time_offset_prior_sigma_s_(config.time_offset_sigma_s) {}
 
 WindowFrame* SlidingWindow::find(std::uint64_t uid) const {
   for (const auto& f : frames_) {
@@ -63,7 +64,7 @@ bool SlidingWindow::priorHoldsTimeOffset() const {
 }
 
 std::shared_ptr<ceres::CostFunction> SlidingWindow::timeOffsetPrior() const {
-  const ceres::Matrix A = ceres::Matrix::Constant(1, 1, 1.0 / config_.time_offset_sigma_s);
+  const ceres::Matrix A = ceres::Matrix::Constant(1, 1, 1.0 / time_offset_prior_sigma_s_);
   const ceres::Vector b = ceres::Vector::Constant(1, time_offset_prior_mean_s_);
   return std::make_shared<ceres::NormalPrior>(A, b);
 }
@@ -303,7 +304,10 @@ void SlidingWindow::dropNewest() {
 }
 
 void SlidingWindow::clear() {
-  time_offset_prior_mean_s_ = *time_offset_s_;  // the next window starts from the estimate
+  // The next window starts from the estimate, with the configured uncertainty (what the window
+  // had learnt about it is gone with its prior).
+  time_offset_prior_mean_s_ = *time_offset_s_;
+  time_offset_prior_sigma_s_ = config_.time_offset_sigma_s;
   frames_.clear();
   landmarks_.clear();
   prior_.reset();

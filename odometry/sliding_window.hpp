@@ -9,6 +9,7 @@
 #include <deque>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "odometry/imu_preintegration.hpp"
@@ -97,10 +98,12 @@ class SlidingWindow {
   // when config.estimate_time_offset. It outlives clear(): a restart keeps the estimate.
   [[nodiscard]] double timeOffsetS() const { return *time_offset_s_; }
   // Sets t_d (the initialisation's estimate); it becomes the prior's mean until the
-  // marginalisation prior holds t_d.
-  void setTimeOffsetS(double t_d_s) {
+  // marginalisation prior holds t_d, with `sigma_s` as its 1-sigma when given (what the
+  // initialisation observed), else vio.time_offset_sigma_s.
+  void setTimeOffsetS(double t_d_s, std::optional<double> sigma_s = std::nullopt) {
     *time_offset_s_ = t_d_s;
     time_offset_prior_mean_s_ = t_d_s;
+    time_offset_prior_sigma_s_ = sigma_s.value_or(config_.time_offset_sigma_s);
   }
 
  private:
@@ -139,6 +142,7 @@ class SlidingWindow {
   // Heap-held so that its address (the Ceres block) never moves with the window.
   std::unique_ptr<double> time_offset_s_ = std::make_unique<double>(0.0);
   double time_offset_prior_mean_s_ = 0.0;
+  double time_offset_prior_sigma_s_;  // config_.time_offset_sigma_s unless set
 };
 
 }  // namespace gvio::odometry

@@ -22,6 +22,8 @@ double msSince(Clock::time_point start) {
 constexpr double kTimeJumpS = 1.0;
 // A keyframe at least this often bounds the preintegration length (and a standing vehicle).
 constexpr double kMaxKeyframeIntervalS = 1.0;
+// IMU kept before the oldest frame of a window not yet aligned, for its re-timing (t_d up to this).
+constexpr std::int64_t kRetimeImuMarginNs = 200'000'000;
 
 PinholeView viewOf(const CameraModel& cam) {
   PinholeView v;
@@ -247,6 +249,10 @@ void VioEstimator::Impl::finishFrame(const WindowFrame& f) {
   // IMU still needed: from the newest window frame on, and the static-detection interval.
   std::int64_t keep = latest.t_ns - static_cast<std::int64_t>(config.init_window_s * 1e9);
   if (!window.frames().empty()) keep = std::min(keep, window.frames().back()->stateNs());
+  // Before the alignment the window may be re-timed (retimeWindow): its IMU is kept, with a margin.
+  if (config.estimate_time_offset && !imu_aligned && !window.frames().empty()) {
+    keep = std::min(keep, window.frames().front()->stateNs() - kRetimeImuMarginNs);
+  }
   imu.dropBefore(std::min(keep, latest.t_ns));
 }
 
