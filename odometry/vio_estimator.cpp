@@ -235,11 +235,7 @@ FrameResult VioEstimator::Impl::process(std::int64_t t_ns, const TrackedFrame& t
 
 void VioEstimator::Impl::finishFrame(const WindowFrame& f) {
   if (latest.valid) previous_pose = latest.T_w_b;
-  latest.valid = true;
-  latest.t_ns = f.stateNs();
-  latest.T_w_b = f.T_w_b();
-  latest.v_w = Eigen::Map<const Eigen::Vector3d>(f.speed_bias.data());
-  latest.bias = f.bias();
+  latest = stateOf(f);
   if (f.keyframe) {
     ++counters.keyframes;
     while (window.keyframeCount() > config.window_size) window.marginalizeOldest(imuActive());

@@ -1,6 +1,8 @@
 #pragma once
 // Internal state of VioEstimator (shared by vio_estimator.cpp and vio_initialization.cpp).
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,6 +27,16 @@ struct LatestState {
   Eigen::Vector3d v_w = Eigen::Vector3d::Zero();
   ImuBias bias;
 };
+
+// The state of a window frame, at its state time (WindowFrame::stateNs).
+LatestState stateOf(const WindowFrame& f);
+
+// How far before its stamp a frame's state goes for a time offset t_d_s (WindowFrame::retime_ns):
+// max(0, t_d). The IMU has arrived up to the stamp, not beyond, so a negative t_d stays with the
+// pixel motion.
+inline std::int64_t retimeNsFor(double t_d_s) {
+  return static_cast<std::int64_t>(std::llround(std::max(0.0, t_d_s) * 1e9));
+}
 
 struct VioEstimator::Impl {
   Impl(const EstimatorConfig& c, const StereoGeometry& g);
@@ -80,6 +92,11 @@ struct VioEstimator::Impl {
   // left to the pixel motion of the window's first solves, whose velocities are noisy differences,
   // the offset came out attenuated (a 20 ms lag estimated at 19.1 ms, then pulled to 14.6 ms).
   bool retimeWindow(double t_d_s);
+  // The visual-inertial alignment of `af` (the window's frames) with the t_d prior it is given
+  // (`prior`, set here); when it observes t_d the window is re-timed to it (retimeWindow) and the
+  // alignment runs again, with `af`'s preintegrations and `prior` taken from the re-timed window.
+  std::optional<AlignmentResult> alignRetimed(std::vector<AlignmentFrame>& af, bool mono,
+                                              std::optional<TimeOffsetPrior>& prior);
   // Moves the window's poses from the exposures to the stamps by the alignment's t_d.
   void moveToStamps(const AlignmentResult& result);
   void reportWaiting(std::int64_t t_ns, const std::string& why);

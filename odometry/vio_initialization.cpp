@@ -140,21 +140,11 @@ bool VioEstimator::Impl::motionInitialize(std::int64_t t_ns) {
     if (k > 0) a.preintegration = frames[k]->preintegration;
     af.push_back(a);
   }
-  std::optional<TimeOffsetPrior> t_d_prior = timeOffsetPrior();
-  auto result = alignVisualInertial(af, false, 0.1, 0.05, t_d_prior);
+  std::optional<TimeOffsetPrior> t_d_prior;
+  const auto result = alignRetimed(af, false, t_d_prior);
   if (!result) {
     reportWaiting(t_ns, "visual-inertial alignment not yet well conditioned: waiting");
     return false;
-  }
-  if (t_d_prior && result->t_d_observed && retimeWindow(windowRetimeS() + result->t_d_s)) {
-    for (std::size_t k = 1; k < frames.size(); ++k)
-      af[k].preintegration = frames[k]->preintegration;
-    t_d_prior = timeOffsetPrior();
-    result = alignVisualInertial(af, false, 0.1, 0.05, t_d_prior);
-    if (!result) {
-      reportWaiting(t_ns, "visual-inertial alignment not yet well conditioned: waiting");
-      return false;
-    }
   }
   ImuBias bias;
   bias.gyr = result->gyr_bias;
@@ -217,15 +207,8 @@ bool VioEstimator::Impl::monoInitialize(std::int64_t t_ns) {
     af[k].lever_v = T_v_c.rotation() * T_c_b.translation();
     if (k > 0) af[k].preintegration = frames[k]->preintegration;
   }
-  std::optional<TimeOffsetPrior> t_d_prior = timeOffsetPrior();
-  auto result = alignVisualInertial(af, true, 0.1, 0.05, t_d_prior);
-  if (result && t_d_prior && result->t_d_observed &&
-      retimeWindow(windowRetimeS() + result->t_d_s)) {
-    for (std::size_t k = 1; k < frames.size(); ++k)
-      af[k].preintegration = frames[k]->preintegration;
-    t_d_prior = timeOffsetPrior();
-    result = alignVisualInertial(af, true, 0.1, 0.05, t_d_prior);
-  }
+  std::optional<TimeOffsetPrior> t_d_prior;
+  const auto result = alignRetimed(af, true, t_d_prior);
   if (!result) {
     reportWaiting(t_ns,
                   "mono+IMU: scale not yet observable (SfM solved, alignment waits for "
@@ -266,9 +249,23 @@ bool VioEstimator::Impl::monoInitialize(std::int64_t t_ns) {
   return true;
 }
 
+std::optional<AlignmentResult> VioEstimator::Impl::alignRetimed(
+    std::vector<AlignmentFrame>& af, bool mono, std::optional<TimeOffsetPrior>& prior) {
+  prior = timeOffsetPrior();
+  auto result = alignVisualInertial(af, mono, 0.1, 0.05, prior);
+  if (!result || !prior || !result->t_d_observed ||
+      !retimeWindow(windowRetimeS() + result->t_d_s)) {
+    return result;
+  }
+  const auto& frames = window.frames();
+  for (std::size_t k = 1; k < frames.size(); ++k) af[k].preintegration = frames[k]->preintegration;
+  prior = timeOffsetPrior();
+  return alignVisualInertial(af, mono, 0.1, 0.05, prior);
+}
+
 bool VioEstimator::Impl::retimeWindow(double t_d_s) {
   auto& frames = window.frames();
-  const auto retime = static_cast<std::int64_t>(std::llround(std::max(0.0, t_d_s) * 1e9));
+  const std::int64_t retime = retimeNsFor(t_d_s);
   if (frames.size() < 2 || retime == frames.front()->retime_ns) return false;
   const auto max_hold = static_cast<std::int64_t>(config.max_imu_gap_s * 1e9);
   std::vector<std::shared_ptr<ImuPreintegration>> pre(frames.size());

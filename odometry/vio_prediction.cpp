@@ -104,8 +104,7 @@ std::optional<Eigen::Isometry3d> VioEstimator::Impl::predictVisual(const Tracked
 
 std::int64_t VioEstimator::Impl::retimeNs(std::int64_t t_ns) const {
   if (!config.estimate_time_offset || !usesImu(config.mode)) return 0;
-  // The IMU has arrived up to the stamp, not beyond: a negative t_d stays with the pixel motion.
-  auto r = static_cast<std::int64_t>(std::llround(std::max(0.0, window.timeOffsetS()) * 1e9));
+  std::int64_t r = retimeNsFor(window.timeOffsetS());
   // The states stay in time order whatever t_d does.
   const auto& frames = window.frames();
   if (!frames.empty()) r = std::min(r, t_ns - frames.back()->stateNs() - 1);
@@ -128,13 +127,18 @@ LatestState VioEstimator::Impl::propagate(const LatestState& from, std::int64_t 
   return to;
 }
 
-LatestState VioEstimator::Impl::atStamp(const WindowFrame& f) const {
+LatestState stateOf(const WindowFrame& f) {
   LatestState s;
   s.valid = true;
   s.t_ns = f.stateNs();
   s.T_w_b = f.T_w_b();
   s.v_w = Eigen::Map<const Eigen::Vector3d>(f.speed_bias.data());
   s.bias = f.bias();
+  return s;
+}
+
+LatestState VioEstimator::Impl::atStamp(const WindowFrame& f) const {
+  const LatestState s = stateOf(f);
   const auto max_hold = static_cast<std::int64_t>(config.max_imu_gap_s * 1e9);
   if (f.retime_ns == 0 || !imuActive() || !imu.covers(s.t_ns, f.t_ns, max_hold)) return s;
   return propagate(s, f.t_ns);

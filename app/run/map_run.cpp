@@ -75,16 +75,16 @@ void MapRecorder::addKeyframe(const KeyframeInput& kf) {
 }
 
 mapping::PoseLookup mapPoses(const MapRecorder& recorder, const MapPoseSource& source) {
-  const Trajectory* fused = source.fused;
-  const bool has_fused = fused != nullptr && !fused->empty();
+  const auto usable = [](const Trajectory* t) { return t != nullptr && !t->empty(); };
+  const Trajectory* fused = usable(source.fused) ? source.fused : nullptr;
+  const Trajectory* traj = fused != nullptr ? fused : usable(source.vio) ? source.vio : nullptr;
   const auto lag_ns = static_cast<std::int64_t>(std::llround(source.exposure_lag_s * 1e9));
-  if (lag_ns == 0 || (!has_fused && (source.vio == nullptr || source.vio->empty()))) {
-    if (!has_fused) return recorder.builder().vioPoses();
+  if (lag_ns == 0 || traj == nullptr) {
+    if (fused == nullptr) return recorder.builder().vioPoses();
     return [fused](std::int64_t t_ns) { return fusion::interpolatePose(*fused, t_ns); };
   }
   // The dense points and landmarks of a keyframe come from its images, taken t_d before the stamp:
   // at 10 m/s a 20 ms lag would otherwise put them 0.2 m along the track.
-  const Trajectory* traj = has_fused ? fused : source.vio;
   return [traj, lag_ns](std::int64_t t_ns) {
     if (auto at_exposure = fusion::interpolatePose(*traj, t_ns - lag_ns)) return at_exposure;
     return fusion::interpolatePose(*traj, t_ns);
