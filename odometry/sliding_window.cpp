@@ -4,7 +4,12 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include <algorithm>
+#include <vector>
+
+#include "odometry/fixed_block_cost.hpp"
 #include "odometry/imu_factor.hpp"
+#include "odometry/lie.hpp"
 #include "odometry/time_offset_factor.hpp"
 
 namespace gvio::odometry {
@@ -142,6 +147,37 @@ void SlidingWindow::timeOffsetFactors(Landmark& lm, WindowFrame& anchor,
   }
 }
 
+TimeOffsetExcitation SlidingWindow::timeOffsetExcitation() const {
+  // Each IMU interval's mean angular rate Log(dR)/dt and mean specific force dv/dt, both in the
+  // body frame at the interval's start: constant over the window for a stationary motion.
+  std::vector<Eigen::Vector3d> rates, forces;
+  for (std::size_t k = 1; k < frames_.size(); ++k) {
+    const auto& pre = frames_[k]->preintegration;
+    if (!pre || pre->deltaT() <= 0.0) continue;
+    rates.push_back(logSo3(pre->deltaR()) / pre->deltaT());
+    forces.push_back(pre->deltaV() / pre->deltaT());
+  }
+  TimeOffsetExcitation e;
+  if (rates.size() < 2) return e;
+  const auto spread = [](const std::vector<Eigen::Vector3d>& xs) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& x : xs) mean += x;
+    mean /= static_cast<double>(xs.size());
+    double worst = 0.0;
+    for (const auto& x : xs) worst = std::max(worst, (x - mean).norm());
+    return worst;
+  };
+  e.rate_change_radps = spread(rates);
+  e.force_change_mps2 = spread(forces);
+  return e;
+}
+
+bool SlidingWindow::timeOffsetUnobservable() const {
+  const TimeOffsetExcitation e = timeOffsetExcitation();
+  return e.rate_change_radps < config_.time_offset_min_rate_change_radps &&
+         e.force_change_mps2 < config_.time_offset_min_force_change_mps2;
+}
+
 void SlidingWindow::reintegrateIfNeeded() {
   for (std::size_t k = 1; k < frames_.size(); ++k) {
     auto& pre = frames_[k]->preintegration;
@@ -194,6 +230,10 @@ SolveStats SlidingWindow::solve(bool use_imu) {
   }
   if (with_time_offset && !priorHoldsTimeOffset()) {
     add(timeOffsetPrior(), nullptr, {time_offset_s_.get()});
+  }
+  stats.time_offset_held = with_time_offset && timeOffsetUnobservable();
+  if (stats.time_offset_held && problem.HasParameterBlock(time_offset_s_.get())) {
+    problem.SetParameterBlockConstant(time_offset_s_.get());
   }
   bool anchored = false;
   for (const AnchorFactor& a : anchors_) {
@@ -249,9 +289,18 @@ void SlidingWindow::marginalizeOldest(bool use_imu) {
       pose_named = speed_bias_named = true;
     }
     const bool with_time_offset = estimatesTimeOffset(use_imu);
+    // Where the motion cannot observe t_d, what the residuals appear to say about it is model
+    // error: they are folded in with t_d held at its value, so the prior learns nothing of it.
+    const bool hold_time_offset = with_time_offset && timeOffsetUnobservable();
     bool time_offset_named = false;
     const auto sink = [&](std::shared_ptr<ceres::CostFunction> cost,
                           const ceres::LossFunction* loss, std::vector<double*> blocks) {
+      if (hold_time_offset && blocks.back() == time_offset_s_.get()) {
+        cost =
+            std::make_shared<FixedBlockCost>(std::move(cost), static_cast<int>(blocks.size()) - 1,
+                                             std::vector<double>{*time_offset_s_});
+        blocks.pop_back();
+      }
       time_offset_named = time_offset_named || blocks.back() == time_offset_s_.get();
       // The loss is owned by the window and outlives the marginaliser.
       m.addResidualBlock(std::move(cost), std::shared_ptr<const ceres::LossFunction>(huber_, loss),

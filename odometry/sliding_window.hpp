@@ -59,6 +59,17 @@ struct SolveStats {
   int residual_blocks = 0;
   int iterations = 0;
   bool converged = false;
+  bool time_offset_held = false;  // t_d estimated but held: the window's motion cannot observe it
+};
+
+// How far the window's motion is from stationary (constant body-frame angular rate and specific
+// force), the motion under which t_d is unobservable (Li and Mourikis, "Online temporal
+// calibration for camera-IMU systems: theory and algorithms", IJRR 2014, sec. 4): shifting every
+// state in time by dt_d then agrees with the IMU as well as the true states do. Largest deviation
+// of an inter-frame interval's mean rate and force from their window means.
+struct TimeOffsetExcitation {
+  double rate_change_radps = 0.0;
+  double force_change_mps2 = 0.0;
 };
 
 class SlidingWindow {
@@ -73,6 +84,10 @@ class SlidingWindow {
   [[nodiscard]] PoseLookup poseLookup() const;
   [[nodiscard]] int keyframeCount() const;
   [[nodiscard]] bool hasPrior() const { return prior_ != nullptr; }
+  [[nodiscard]] TimeOffsetExcitation timeOffsetExcitation() const;
+  // Whether the window's motion is too close to stationary to observe t_d (the config's
+  // thresholds): solve() then keeps t_d where it is.
+  [[nodiscard]] bool timeOffsetUnobservable() const;
 
   // One nonlinear least-squares solve. IMU residuals join when `use_imu` (then the speed/bias
   // blocks are variables); without a prior the oldest pose is held fixed (the gauge).

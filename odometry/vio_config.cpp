@@ -61,6 +61,12 @@ void EstimatorConfig::validate() const {
   require(positive(time_offset_sigma_s), "time_offset_sigma_s", "> 0");
   require(std::isfinite(time_offset_random_walk_s) && time_offset_random_walk_s >= 0.0,
           "time_offset_random_walk_s", ">= 0");
+  require(
+      std::isfinite(time_offset_min_rate_change_radps) && time_offset_min_rate_change_radps >= 0.0,
+      "time_offset_min_rate_change_radps", ">= 0");
+  require(
+      std::isfinite(time_offset_min_force_change_mps2) && time_offset_min_force_change_mps2 >= 0.0,
+      "time_offset_min_force_change_mps2", ">= 0");
   require(positive(gyr_bias_prior_radps), "gyr_bias_prior_radps", "> 0");
   require(min_features_tracking >= 5, "min_features_tracking", ">= 5");
 }

@@ -63,6 +63,8 @@ struct VioCounters {
   int lost_frames = 0;      // frames with too few features to estimate
   int coasted_frames = 0;   // frames propagated on the IMU alone
   int imu_gaps = 0;
+  // Solves of the time offset that held it: the window's motion too steady to observe it.
+  int time_offset_held_solves = 0;
 };
 
 class VioEstimator {

@@ -41,6 +41,7 @@ json timeOffsetJson(const io::Dataset& ds, const VioRunResult& run) {
           {"calibration_timeshift_cam_imu_s", ds.camera_timeshift_s},
           {"t_d_s", run.time_offset_s},
           {"stamp_lag_s", run.time_offset_s - ds.camera_timeshift_s},
+          {"held_solves", run.counters.time_offset_held_solves},
           {"history", history}};
 }
 
