@@ -121,8 +121,10 @@ Dataset readComma2k19(const fs::path& dir, const ReaderConfig& config) {
   Trajectory truth;
   forEachRow(gt, {"t_boot_s", "ecef_x", "ecef_y", "ecef_z", "q0", "q1", "q2", "q3"},
              [&](const LineReader& at, std::int64_t t_ns, const std::vector<double>& v) {
-               const Eigen::Quaterniond q_ecef_dev(v[3], v[4], v[5], v[6]);
-               if (std::abs(q_ecef_dev.norm() - 1.0) > 1e-3) at.fail("quaternion not unit norm");
+               const Eigen::Quaterniond q_read(v[3], v[4], v[5], v[6]);
+               if (std::abs(q_read.norm() - 1.0) > 1e-3) at.fail("quaternion not unit norm");
+               // Within the tolerance, not exactly unit: a rotation only once normalised.
+               const Eigen::Quaterniond q_ecef_dev = q_read.normalized();
                Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
                T.linear() = enu.R_enu_ecef() * q_ecef_dev.toRotationMatrix() *
                             kFrdToFlu.asDiagonal().toDenseMatrix();
