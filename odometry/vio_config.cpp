@@ -16,6 +16,10 @@ bool positive(double v) {
   return std::isfinite(v) && v > 0.0;
 }
 
+bool nonNegative(double v) {
+  return std::isfinite(v) && v >= 0.0;
+}
+
 }  // namespace
 
 std::string toString(VioMode mode) {
@@ -59,14 +63,11 @@ void EstimatorConfig::validate() const {
   require(positive(init_velocity_sigma_mps), "init_velocity_sigma_mps", "> 0");
   require(positive(acc_bias_prior_mps2), "acc_bias_prior_mps2", "> 0");
   require(positive(time_offset_sigma_s), "time_offset_sigma_s", "> 0");
-  require(std::isfinite(time_offset_random_walk_s) && time_offset_random_walk_s >= 0.0,
-          "time_offset_random_walk_s", ">= 0");
-  require(
-      std::isfinite(time_offset_min_rate_change_radps) && time_offset_min_rate_change_radps >= 0.0,
-      "time_offset_min_rate_change_radps", ">= 0");
-  require(
-      std::isfinite(time_offset_min_force_change_mps2) && time_offset_min_force_change_mps2 >= 0.0,
-      "time_offset_min_force_change_mps2", ">= 0");
+  require(nonNegative(time_offset_random_walk_s), "time_offset_random_walk_s", ">= 0");
+  require(nonNegative(time_offset_min_rate_change_radps), "time_offset_min_rate_change_radps",
+          ">= 0");
+  require(nonNegative(time_offset_min_force_change_mps2), "time_offset_min_force_change_mps2",
+          ">= 0");
   require(positive(gyr_bias_prior_radps), "gyr_bias_prior_radps", "> 0");
   require(min_features_tracking >= 5, "min_features_tracking", ">= 5");
 }
