@@ -111,6 +111,14 @@ std::vector<bool> kltForwardBackward(const std::vector<cv::Mat>& from,
   std::vector<float> err;
   cv::calcOpticalFlowPyrLK(from, to, from_px, to_px, status, err, win, c.klt_levels, term,
                            use_guess ? cv::OPTFLOW_USE_INITIAL_FLOW : 0);
+  if (c.klt_refine_window_px > 0) {
+    // Full resolution only (level 0 of the same pyramids), from the pyramidal result.
+    std::vector<std::uint8_t> refined;
+    const cv::Size refine_win(c.klt_refine_window_px, c.klt_refine_window_px);
+    cv::calcOpticalFlowPyrLK(from, to, from_px, to_px, refined, err, refine_win, 0, term,
+                             cv::OPTFLOW_USE_INITIAL_FLOW);
+    for (std::size_t i = 0; i < status.size(); ++i) status[i] = status[i] != 0 && refined[i] != 0;
+  }
   // The reverse pass starts at the original position: a correct track comes straight back.
   std::vector<cv::Point2f> back_px = from_px;
   cv::calcOpticalFlowPyrLK(to, from, to_px, back_px, back_status, err, win,
@@ -139,6 +147,10 @@ void TrackerConfig::validate() const {
              "odd and >= 3");
   requireInt(klt_levels >= 0 && klt_levels <= 8, "klt_levels", klt_levels, "in [0, 8]");
   requireInt(klt_iterations >= 1, "klt_iterations", klt_iterations, ">= 1");
+  requireInt(
+      klt_refine_window_px == 0 || (klt_refine_window_px >= 3 && klt_refine_window_px % 2 == 1 &&
+                                    klt_refine_window_px <= klt_window_px),
+      "klt_refine_window_px", klt_refine_window_px, "0, or odd, >= 3 and <= klt_window_px");
   requirePositive("fb_threshold_px", fb_threshold_px);
   requirePositive("ransac_threshold_px", ransac_threshold_px);
   requirePositive("stereo_max_vertical_px", stereo_max_vertical_px);

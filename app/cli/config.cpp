@@ -258,6 +258,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       integer("vio.tracker.klt_window_px", e.tracker.klt_window_px),
       integer("vio.tracker.klt_levels", e.tracker.klt_levels),
       integer("vio.tracker.klt_iterations", e.tracker.klt_iterations),
+      integer("vio.tracker.klt_refine_window_px", e.tracker.klt_refine_window_px),
       number("vio.tracker.fb_threshold_px", e.tracker.fb_threshold_px),
       number("vio.tracker.ransac_threshold_px", e.tracker.ransac_threshold_px),
       number("vio.tracker.stereo_max_vertical_px", e.tracker.stereo_max_vertical_px),

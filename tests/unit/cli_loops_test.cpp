@@ -117,7 +117,11 @@ TEST_F(CliLoops, WithSppGnssLoopsImproveTheFusedTrajectoryInEveryGnssMode) {
       EXPECT_GT(with_map["second_pass_keyframes"].get<int>(), 50);
       EXPECT_GE(with_map["fraction_within"].get<double>(), 0.95);
       EXPECT_TRUE(with_map["meets_target"].get<bool>());
-      EXPECT_LT(without_map["fraction_within"].get<double>(), 0.8);
+      // Without loops the second pass lies where its own SPP fixes put it. Measured on this drive:
+      // 94.1 % with the VIO of 2026-11-27 (its full-resolution KLT pass; 36.9 % when this test was
+      // written) and 97.4 % with loops: the loops must still add to it.
+      EXPECT_GT(with_map["fraction_within"].get<double>(),
+                without_map["fraction_within"].get<double>());
     }
     EXPECT_GE(loops["accepted"].get<int>(), 20) << mode;
     EXPECT_GT(loops["graph"]["fixes"].get<int>(), 40) << mode;
