@@ -45,10 +45,13 @@ const StereoFrames& frames() {
 }
 
 // One iteration = one frame, in drive order; at the end of the drive the tracker starts over
-// (reset outside the timing), so about 1 frame in 31 pays for a full detection.
+// (reset outside the timing), so about 1 frame in 31 pays for a full detection. The argument is
+// the full-resolution KLT pass's window (0: without it; 7: the default).
 void BM_FeatureTrackerStereoKitti(benchmark::State& state) {
   const StereoFrames& f = frames();
-  FeatureTracker tracker{TrackerConfig{}};
+  TrackerConfig config;
+  config.klt_refine_window_px = static_cast<int>(state.range(0));
+  FeatureTracker tracker{config};
   std::size_t k = 0;
   double features = 0, ms_track = 0, ms_detect = 0, ms_stereo = 0;
   for (auto _ : state) {
@@ -72,6 +75,8 @@ void BM_FeatureTrackerStereoKitti(benchmark::State& state) {
 }
 // Five passes over the drive, so every run averages the same mix of frames.
 BENCHMARK(BM_FeatureTrackerStereoKitti)
+    ->Arg(0)
+    ->Arg(TrackerConfig{}.klt_refine_window_px)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(155);
