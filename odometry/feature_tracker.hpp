@@ -27,7 +27,7 @@ struct TrackerConfig {
   // per row on KITTI; its texture expands under forward motion) the fit is the gradient-weighted
   // mean of the displacements over the window, and any uneven spread of gradient energy biases
   // it. Near ground points came out 0.1 px too wide in disparity and 2 % short in flow over a 21 px
-  // window, which made the VIO's trajectories 0.1-0.8 % short; the small window reduces the
+  // window, which made the VIO's trajectories 0.04-0.8 % short; the small window reduces the
   // deformation it averages over, while the pyramid (large window) still finds large motions.
   int klt_refine_window_px = 7;
   double fb_threshold_px = 1.0;         // forward-backward check: max round-trip miss
