@@ -411,13 +411,14 @@ TEST(FeatureTrackerConfig, BadValuesNameTheField) {
 
 // A rectified pair of a plane whose disparity grows by 0.33 px per row (the road seen from a KITTI
 // rig: b / h = 0.54 m / 1.65 m), textured with a contrast that falls with the distance (as
-// texture filtering blurs the far road). A 21 px window averages disparities 3.3 px apart, weighted
+// texture filtering blurs the far road). A 21 px window averages disparities up to 3.3 px either
+// side of its centre's, weighted
 // by the stronger gradients of its near rows: the disparity comes out too wide. The full-resolution
 // pass with the small window (the default) takes most of that bias out.
 double meanDisparityError(int refine_window_px) {
   constexpr int kW = 640, kH = 240;
-  constexpr double kRow0 = 20.0, kBase = 10.0,
-                   kSlope = 0.33;  // disparity at row y: base + slope (y - row0)
+  // Disparity at row y: base + slope (y - row0).
+  constexpr double kRow0 = 20.0, kBase = 10.0, kSlope = 0.33;
   cv::Mat noise(kH, kW + 200, CV_32F);
   cv::RNG rng(17);
   rng.fill(noise, cv::RNG::NORMAL, 0.0, 1.0);
