@@ -46,7 +46,8 @@ void EstimatorConfig::validate() const {
   tracker.validate();
   if (usesImu(mode)) imu_noise.validate();
   require(window_size >= 3 && window_size <= 50, "window_size", "in [3, 50]");
-  require(positive(keyframe_parallax_px), "keyframe_parallax_px", "> 0");
+  require(positive(keyframe_parallax_deg) && keyframe_parallax_deg < 45.0, "keyframe_parallax_deg",
+          "in (0, 45)");
   require(keyframe_min_tracked >= 1, "keyframe_min_tracked", ">= 1");
   require(positive(pixel_sigma_px), "pixel_sigma_px", "> 0");
   require(positive(huber_sigmas), "huber_sigmas", "> 0");

@@ -129,7 +129,9 @@ bool VioEstimator::Impl::isKeyframe(const WindowFrame& f, const TrackedFrame& tr
   if (static_cast<double>(f.t_ns - last_kf.t_ns) * 1e-9 >= kMaxKeyframeIntervalS) return true;
   const Parallax parallax = parallaxTo(tracked, last_kf.uid);
   if (parallax.count < config.keyframe_min_tracked) return true;
-  return parallax.mean_px >= config.keyframe_parallax_px;
+  // The threshold is an angle (VINS-Mono: MIN_PARALLAX = 10 px / FOCAL_LENGTH), so a pixel means
+  // less on a long lens: the rectified left focal length converts it.
+  return parallax.mean_px / geometry.left.fx >= config.keyframe_parallax_deg * M_PI / 180.0;
 }
 
 VioEstimator::Impl::Parallax VioEstimator::Impl::parallaxTo(const TrackedFrame& tracked,

@@ -115,6 +115,16 @@ void flatten(const YAML::Node& node, const std::string& prefix,
 // Where each key's value came from: the config file's line, or --set (line 0).
 using KeyOrigins = std::map<std::string, std::size_t>;
 
+// Keys that were replaced by one with another unit: ignoring them (as an unknown key is) would
+// silently run with the default, so they are an error that says what to write instead.
+const char* replacementOf(const std::string& key) {
+  if (key == "vio.keyframe_parallax_px") {
+    return "'vio.keyframe_parallax_px' was replaced by 'vio.keyframe_parallax_deg' (an angle: "
+           "pixels / focal length; 10 px on KITTI's 718 px camera is 0.8 deg)";
+  }
+  return nullptr;
+}
+
 void applyFile(const std::filesystem::path& file, std::map<std::string, ConfigKey*>& keys,
                std::vector<std::string>* unknown_keys, KeyOrigins* origins = nullptr) {
   YAML::Node root;
@@ -130,6 +140,7 @@ void applyFile(const std::filesystem::path& file, std::map<std::string, ConfigKe
   std::vector<std::pair<std::string, FlatEntry>> entries;
   flatten(root, "", entries, file);
   for (const auto& [key, entry] : entries) {
+    if (const char* why = replacementOf(key)) throw io::InputError(file, entry.line, why);
     const auto it = keys.find(key);
     if (it == keys.end()) {
       spdlog::warn("{}:{}: unknown config key '{}' ignored", file.string(), entry.line, key);
@@ -152,6 +163,7 @@ void applyOverride(const std::string& assignment, std::map<std::string, ConfigKe
     throw InvalidInput("--set '" + assignment + "': expected key=value");
   }
   const std::string key = assignment.substr(0, eq);
+  if (const char* why = replacementOf(key)) throw InvalidInput(std::string("--set: ") + why);
   const auto it = keys.find(key);
   if (it == keys.end()) throw InvalidInput("--set: unknown config key '" + key + "'");
   try {
@@ -227,7 +239,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("imu.gyr_random_walk", c.imu.noise.gyr_random_walk),
       text("vio.mode", c.vio.mode),
       integer("vio.window_size", e.window_size),
-      number("vio.keyframe_parallax_px", e.keyframe_parallax_px),
+      number("vio.keyframe_parallax_deg", e.keyframe_parallax_deg),
       integer("vio.keyframe_min_tracked", e.keyframe_min_tracked),
       number("vio.pixel_sigma_px", e.pixel_sigma_px),
       number("vio.huber_sigmas", e.huber_sigmas),

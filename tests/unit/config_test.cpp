@@ -116,6 +116,25 @@ TEST(Config, OverrideErrors) {
   EXPECT_THAT(errorOf({std::nullopt, {"gap_factor"}}), HasSubstr("expected key=value"));
 }
 
+// A key replaced by one in another unit is an error that names the new key, in a file (with its
+// line) and in --set: ignored like an unknown key, the run would silently use the default.
+TEST(Config, AReplacedKeyNamesItsReplacement) {
+  test::TempDir dir("config");
+  const fs::path file = dir.path() / "c.yaml";
+  test::writeText(file, "vio:\n  window_size: 12\n  keyframe_parallax_px: 15\n");
+  const std::string from_file = errorOf({file, {}});
+  EXPECT_THAT(from_file, HasSubstr(file.string() + ":3: "));
+  EXPECT_THAT(from_file, HasSubstr("vio.keyframe_parallax_deg"));
+  EXPECT_THAT(errorOf({std::nullopt, {"vio.keyframe_parallax_px=15"}}),
+              HasSubstr("--set: 'vio.keyframe_parallax_px' was replaced by "
+                        "'vio.keyframe_parallax_deg'"));
+  EXPECT_THAT(errorOf({std::nullopt, {"vio.keyframe_parallax_deg=0"}}),
+              HasSubstr("vio.keyframe_parallax_deg"));
+  EXPECT_THAT(errorOf({std::nullopt, {"vio.keyframe_parallax_deg=50"}}),
+              HasSubstr("vio.keyframe_parallax_deg"));
+  EXPECT_TRUE(errorOf({std::nullopt, {"vio.keyframe_parallax_deg=1.25"}}).empty());
+}
+
 TEST(Config, FileErrors) {
   test::TempDir dir("config");
   EXPECT_THAT(errorOf({dir.path() / "missing.yaml", {}}), HasSubstr("not found"));

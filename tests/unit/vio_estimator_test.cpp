@@ -4,6 +4,9 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -45,13 +48,29 @@ struct Perturbation {
   // Feed the frames through run::FrameStepper, tracking each next frame on another thread while
   // the current one is estimated (gvio run --threads >= 2), instead of addFrame.
   bool track_ahead = false;
+  // Images resized by this factor and the cameras' intrinsics with them: the same scene through a
+  // camera of another resolution and focal length.
+  double image_scale = 1.0;
 };
+
+CameraModel scaled(CameraModel cam, double s) {
+  cam.width_px = static_cast<int>(std::lround(cam.width_px * s));
+  cam.height_px = static_cast<int>(std::lround(cam.height_px * s));
+  // Pixel centres at integer coordinates: x' + 0.5 = s (x + 0.5).
+  cam.fx *= s;
+  cam.fy *= s;
+  cam.cx = s * (cam.cx + 0.5) - 0.5;
+  cam.cy = s * (cam.cy + 0.5) - 0.5;
+  return cam;
+}
 
 RunOutput runOn(const io::Dataset& ds, EstimatorConfig config, const Perturbation& p = {}) {
   // Mono: the left camera alone (rectified on its own, no right image needed).
   const bool stereo = usesStereo(config.mode) && ds.cameras.size() > 1;
-  const Rectifier rectifier(ds.cameras[0],
-                            stereo ? std::optional<CameraModel>(ds.cameras[1]) : std::nullopt);
+  const CameraModel cam0 = scaled(ds.cameras[0], p.image_scale);
+  const std::optional<CameraModel> cam1 =
+      stereo ? std::optional<CameraModel>(scaled(ds.cameras[1], p.image_scale)) : std::nullopt;
+  const Rectifier rectifier(cam0, cam1);
   if (ds.imu_noise) config.imu_noise = *ds.imu_noise;
   VioEstimator vio(config, rectifier.left(),
                    usesStereo(config.mode) ? rectifier.right() : std::nullopt);
@@ -60,6 +79,12 @@ RunOutput runOn(const io::Dataset& ds, EstimatorConfig config, const Perturbatio
     cv::Mat left = io::loadGrayImage(frame.image_paths[0], ds.cameras[0]);
     cv::Mat right = usesStereo(config.mode) ? io::loadGrayImage(frame.image_paths[1], ds.cameras[1])
                                             : cv::Mat();
+    if (p.image_scale != 1.0) {
+      cv::resize(left, left, cv::Size(cam0.width_px, cam0.height_px), 0, 0, cv::INTER_AREA);
+      if (!right.empty()) {
+        cv::resize(right, right, cv::Size(cam1->width_px, cam1->height_px), 0, 0, cv::INTER_AREA);
+      }
+    }
     if (p.black(k)) {
       left.setTo(0);
       if (!right.empty()) right.setTo(0);
@@ -162,6 +187,27 @@ TEST_F(VioDrive, MonoImuInitialisesWhileMoving) {
   EXPECT_GE(out.trajectory.size() + 115, ds().frames.size());
   EXPECT_EQ(out.trajectory.t_ns.back(), ds().frames.back().t_ns);
   EXPECT_LT(apeRmse(ds(), out.trajectory), 0.75);
+}
+
+// The keyframe threshold is an angle: the same drive seen through a camera of 0.6 x the
+// resolution and focal length (so every pixel motion is 0.6 x as long) makes about as many
+// keyframes, where the same threshold in pixels (0.8 deg / 0.6 on this camera) makes far fewer.
+TEST_F(VioDrive, TheKeyframeRateDoesNotDependOnTheFocalLength) {
+  EstimatorConfig config;
+  config.mode = VioMode::kStereo;  // the keyframe rule is the same with an IMU, and this is faster
+  Perturbation p;
+  p.skip_frame = [](std::size_t k) { return k >= 60; };  // 6 s at 7.7 m/s
+  const int full = runOn(ds(), config, p).counters.keyframes;
+  p.image_scale = 0.6;
+  const RunOutput small = runOn(ds(), config, p);
+  EXPECT_EQ(small.counters.initializations, 1);
+  const int same_angle = small.counters.keyframes;
+  config.keyframe_parallax_deg /= p.image_scale;  // what the same pixel threshold would be
+  const int same_pixels = runOn(ds(), config, p).counters.keyframes;
+  fmt::print("keyframes of 60 frames: {} at full size, {} at 0.6 x, {} with the pixel threshold\n",
+             full, same_angle, same_pixels);
+  EXPECT_NEAR(same_angle, full, 0.1 * full) << "pixel threshold: " << same_pixels;
+  EXPECT_LT(same_pixels, 0.8 * full) << "angle threshold: " << same_angle;
 }
 
 TEST_F(VioDrive, CoastsThroughBlackFramesOnTheImu) {
