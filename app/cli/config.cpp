@@ -115,8 +115,9 @@ void flatten(const YAML::Node& node, const std::string& prefix,
 // Where each key's value came from: the config file's line, or --set (line 0).
 using KeyOrigins = std::map<std::string, std::size_t>;
 
-// Keys that were replaced by one with another unit: ignoring them (as an unknown key is) would
-// silently run with the default, so they are an error that says what to write instead.
+// Keys that were replaced by one with another unit: their message says what to write instead.
+// In --set they are an error; in a file a warning (the key is ignored, as an unknown one), so the
+// config.yaml of a run made before the change still opens (gvio render, gvio consistency).
 const char* replacementOf(const std::string& key) {
   if (key == "vio.keyframe_parallax_px") {
     return "'vio.keyframe_parallax_px' was replaced by 'vio.keyframe_parallax_deg' (an angle: "
@@ -140,8 +141,12 @@ void applyFile(const std::filesystem::path& file, std::map<std::string, ConfigKe
   std::vector<std::pair<std::string, FlatEntry>> entries;
   flatten(root, "", entries, file);
   for (const auto& [key, entry] : entries) {
-    if (const char* why = replacementOf(key)) throw io::InputError(file, entry.line, why);
     const auto it = keys.find(key);
+    if (const char* why = replacementOf(key)) {
+      spdlog::warn("{}:{}: {}: ignored", file.string(), entry.line, why);
+      if (unknown_keys) unknown_keys->push_back(key);
+      continue;
+    }
     if (it == keys.end()) {
       spdlog::warn("{}:{}: unknown config key '{}' ignored", file.string(), entry.line, key);
       if (unknown_keys) unknown_keys->push_back(key);
