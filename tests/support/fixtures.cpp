@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -188,6 +190,19 @@ fs::path cachedSimulation(const std::string& args) {
   const fs::path cache = fs::path(GVIO_TEST_CACHE_DIR) / fmt::format("sim_{:016x}", key);
   if (fs::exists(cache / "sim.yaml")) return cache;
   fs::create_directories(cache.parent_path());
+  // ctest -j runs a suite's tests side by side, each its own process, and they ask for the same
+  // drive at once: the first simulates it, the others wait on the lock and take its result
+  // (without the lock each simulated the whole drive itself). The lock goes with the process.
+  const int lock_fd =
+      ::open((cache.string() + ".lock").c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
+  if (lock_fd >= 0) ::flock(lock_fd, LOCK_EX);
+  struct Unlock {
+    int fd;
+    ~Unlock() {
+      if (fd >= 0) ::close(fd);
+    }
+  } unlock{lock_fd};
+  if (fs::exists(cache / "sim.yaml")) return cache;
   const fs::path tmp = cache.string() + fmt::format(".tmp{}", static_cast<long>(::getpid()));
   fs::remove_all(tmp);
   const CommandResult r =
