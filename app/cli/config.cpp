@@ -142,13 +142,10 @@ void applyFile(const std::filesystem::path& file, std::map<std::string, ConfigKe
   flatten(root, "", entries, file);
   for (const auto& [key, entry] : entries) {
     const auto it = keys.find(key);
-    if (const char* why = replacementOf(key)) {
-      spdlog::warn("{}:{}: {}: ignored", file.string(), entry.line, why);
-      if (unknown_keys) unknown_keys->push_back(key);
-      continue;
-    }
-    if (it == keys.end()) {
-      spdlog::warn("{}:{}: unknown config key '{}' ignored", file.string(), entry.line, key);
+    if (it == keys.end()) {  // a replaced key is not among them either: it says what replaced it
+      const char* why = replacementOf(key);
+      spdlog::warn("{}:{}: {} ignored", file.string(), entry.line,
+                   why ? std::string(why) + ":" : "unknown config key '" + key + "'");
       if (unknown_keys) unknown_keys->push_back(key);
       continue;
     }

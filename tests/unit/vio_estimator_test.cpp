@@ -54,6 +54,7 @@ struct Perturbation {
 };
 
 CameraModel scaled(CameraModel cam, double s) {
+  if (s == 1.0) return cam;  // bit for bit the dataset's camera
   cam.width_px = static_cast<int>(std::lround(cam.width_px * s));
   cam.height_px = static_cast<int>(std::lround(cam.height_px * s));
   // Pixel centres at integer coordinates: x' + 0.5 = s (x + 0.5).
