@@ -1,6 +1,7 @@
 #include "odometry/vi_alignment.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -42,6 +43,8 @@ struct LinearLayout {
 struct LinearSolution {
   Eigen::VectorXd x;
   double scale_variance = 0.0;  // of x(scaleCol) when the scale is estimated
+  // Covariance of the gravity's tangent correction w (m/s^2)^2 when refining.
+  Eigen::Matrix2d gravity_covariance = Eigen::Matrix2d::Zero();
 };
 
 std::optional<LinearSolution> solveLinear(const std::vector<AlignmentFrame>& frames,
@@ -96,14 +99,20 @@ std::optional<LinearSolution> solveLinear(const std::vector<AlignmentFrame>& fra
   LinearSolution out;
   out.x = ldlt.solve(rhs);
   if (!out.x.allFinite()) return std::nullopt;
+  // Covariance = H^-1 * residual variance (unit weights; the residual sets the noise level).
+  const int rows = 6 * (L.n - 1);
+  const double ssr = std::max(0.0, yty - 2.0 * out.x.dot(rhs) + out.x.dot(H * out.x));
+  const double variance = ssr / std::max(1, rows - dim);
   if (L.scale) {
-    // Covariance = H^-1 * residual variance (unit weights; the residual sets the noise level).
-    const int rows = 6 * (L.n - 1);
-    const double ssr = std::max(0.0, yty - 2.0 * out.x.dot(rhs) + out.x.dot(H * out.x));
-    const double variance = ssr / std::max(1, rows - dim);
     Eigen::VectorXd e = Eigen::VectorXd::Zero(dim);
     e(L.scaleCol()) = 1.0;
     out.scale_variance = ldlt.solve(e)(L.scaleCol()) * variance;
+  }
+  if (L.refine) {
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(dim, 2);
+    E(L.gravityCol(), 0) = 1.0;
+    E(L.gravityCol() + 1, 1) = 1.0;
+    out.gravity_covariance = ldlt.solve(E).middleRows(L.gravityCol(), 2) * variance;
   }
   return out;
 }
@@ -266,6 +275,9 @@ std::optional<AlignmentResult> alignVisualInertial(
     g = (g0 + B * sol->x.segment<2>(L.gravityCol())).normalized() * kGravity_mps2;
   }
   result.g_v = g;
+  // The tangent correction w tilts g by |w| / |g| (rad); its largest 1-sigma is the tilt's.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(sol->gravity_covariance);
+  result.tilt_sigma_rad = std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff())) / kGravity_mps2;
   result.scale = estimate_scale ? sol->x(L.scaleCol()) : 1.0;
   if (!(result.scale > 0.0)) return std::nullopt;
   if (estimate_scale) {

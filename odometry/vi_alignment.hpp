@@ -34,6 +34,10 @@ struct AlignmentResult {
   double scale_rel_sigma = 0.0;                   // 1-sigma of the scale / scale (if estimated)
   Eigen::Matrix3d R_w_v = Eigen::Matrix3d::Identity();  // visual frame -> gravity-aligned world
   double gravity_norm_before_refinement = 0.0;
+  // 1-sigma of the gravity direction (rad), the largest over the two tilt axes: the refined
+  // solve's covariance scaled by its residual variance (unit weights, as the scale's). It is
+  // conservative: about 1.7x the actual spread on noisy synthetic windows.
+  double tilt_sigma_rad = 0.0;
   // Camera-IMU time offset (when asked for): how much the frames' stamps lag the exposures the
   // visual poses belong to (s), and its posterior 1-sigma.
   double t_d_s = 0.0;

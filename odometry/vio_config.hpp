@@ -44,7 +44,13 @@ struct EstimatorConfig {
   double static_gyr_radps = 0.02;    // static detection: gyro/acc spread and pixel motion below
   double static_acc_mps2 = 0.2;
   double static_pixel_motion_px = 0.5;
-  double init_window_s = 1.0;      // frames used by the visual-inertial alignment
+  double init_window_s = 1.0;  // frames used by the visual-inertial alignment
+  // The alignment's gravity direction must be this certain (1-sigma of its own solve, deg) before
+  // a moving window initialises: on large uniform walls a 1 s window's visual poses are too noisy,
+  // and a start 4 deg tilted bends the first 10 s. After init_max_wait_s of uncertain alignments
+  // it initialises anyway, with the tilt prior widened to the alignment's sigma.
+  double init_max_tilt_sigma_deg = 1.0;
+  double init_max_wait_s = 5.0;
   double max_imu_gap_s = 0.1;      // longer gaps without IMU: coast on the visual solution
   int min_features_tracking = 15;  // fewer usable features: the frame is lost (coast/reinit)
   // Priors on the state the IMU window starts from (after initialisation or a restart). With the

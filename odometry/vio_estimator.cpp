@@ -119,6 +119,7 @@ void VioEstimator::Impl::restart(std::int64_t t_ns, const std::string& kind, con
   tracker_reset_pending = true;
   if (!keep_imu_alignment) imu_aligned = false;
   coast_start_ns = -1;
+  uncertain_alignment_since_ns = -1;
   if (keep_imu_alignment && latest.valid) ++counters.initializations;
 }
 
@@ -172,7 +173,9 @@ void VioEstimator::Impl::anchorWindow() {
   StartPrior start;
   // Vision alone: the first pose is the gauge (all six degrees held). With the IMU aligned, tilt
   // is observable and keeps the uncertainty of its initial estimate.
-  start.pose.tilt_rad = imuActive() ? config.init_tilt_sigma_deg * M_PI / 180.0 : 1e-4;
+  start.pose.tilt_rad =
+      imuActive() ? std::max(config.init_tilt_sigma_deg * M_PI / 180.0, start_tilt_sigma_rad)
+                  : 1e-4;
   start.speed_bias = imuActive();
   start.velocity_mps = config.init_velocity_sigma_mps;
   start.acc_bias_mps2 = config.acc_bias_prior_mps2;

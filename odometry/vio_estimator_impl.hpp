@@ -100,6 +100,9 @@ struct VioEstimator::Impl {
   // Moves the window's poses from the exposures to the stamps by the alignment's t_d.
   void moveToStamps(const AlignmentResult& result);
   void reportWaiting(std::int64_t t_ns, const std::string& why);
+  // False while a moving window's alignment is less certain in tilt than configured, until
+  // init_max_wait_s after the first such alignment.
+  bool tiltCertainEnough(std::int64_t t_ns, double tilt_sigma_rad);
   void applyAlignment(const Eigen::Matrix3d& R_w_v, const std::vector<Eigen::Vector3d>& v_v,
                       const ImuBias& bias);
 
@@ -118,6 +121,10 @@ struct VioEstimator::Impl {
   std::optional<Eigen::Isometry3d> previous_pose;  // the frame before `latest` (constant velocity)
   bool imu_aligned = false;  // the window is gravity-aligned with velocities and biases
   bool waiting_reported = false;
+  // The first alignment that was refused as too uncertain in tilt (-1: none since the last start).
+  std::int64_t uncertain_alignment_since_ns = -1;
+  // The initial tilt's prior 1-sigma (rad): the config's, or the alignment's when it is larger.
+  double start_tilt_sigma_rad = 0.0;
   std::uint64_t next_uid = 1;
   std::int64_t last_frame_ns = -1;
   std::int64_t nominal_frame_ns = 0;

@@ -146,17 +146,31 @@ bool VioEstimator::Impl::motionInitialize(std::int64_t t_ns) {
     reportWaiting(t_ns, "visual-inertial alignment not yet well conditioned: waiting");
     return false;
   }
+  if (!tiltCertainEnough(t_ns, result->tilt_sigma_rad)) return false;
   ImuBias bias;
   bias.gyr = result->gyr_bias;
   moveToStamps(*result);
   if (t_d_prior) setInitialTimeOffset(*result);
+  start_tilt_sigma_rad = result->tilt_sigma_rad;
   applyAlignment(result->R_w_v, result->v_v, bias);
+  start_tilt_sigma_rad = 0.0;
   event(t_ns, "initialized",
         "visual-inertial alignment over " + std::to_string(frames.size()) +
             " frames: |g| before refinement " + fmt3(result->gravity_norm_before_refinement) +
-            " m/s^2, gyro bias " + fmt3(bias.gyr.norm() * 180.0 / M_PI) + " deg/s" +
+            " m/s^2, tilt +- " + fmt3(result->tilt_sigma_rad * 180.0 / M_PI) + " deg, gyro bias " +
+            fmt3(bias.gyr.norm() * 180.0 / M_PI) + " deg/s" +
             timeOffsetText(t_d_prior, *result, windowRetimeS()));
   return true;
+}
+
+bool VioEstimator::Impl::tiltCertainEnough(std::int64_t t_ns, double tilt_sigma_rad) {
+  if (tilt_sigma_rad <= config.init_max_tilt_sigma_deg * M_PI / 180.0) return true;
+  if (uncertain_alignment_since_ns < 0) uncertain_alignment_since_ns = t_ns;
+  const double waited_s = static_cast<double>(t_ns - uncertain_alignment_since_ns) * 1e-9;
+  if (waited_s >= config.init_max_wait_s) return true;
+  reportWaiting(t_ns, "visual-inertial alignment: gravity direction uncertain (+- " +
+                          fmt3(tilt_sigma_rad * 180.0 / M_PI) + " deg): waiting");
+  return false;
 }
 
 void VioEstimator::Impl::reportWaiting(std::int64_t t_ns, const std::string& why) {

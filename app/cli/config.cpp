@@ -253,6 +253,8 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("vio.static_acc_mps2", e.static_acc_mps2),
       number("vio.static_pixel_motion_px", e.static_pixel_motion_px),
       number("vio.init_window_s", e.init_window_s),
+      number("vio.init_max_tilt_sigma_deg", e.init_max_tilt_sigma_deg),
+      number("vio.init_max_wait_s", e.init_max_wait_s),
       number("vio.max_imu_gap_s", e.max_imu_gap_s),
       integer("vio.min_features_tracking", e.min_features_tracking),
       number("vio.init_tilt_sigma_deg", e.init_tilt_sigma_deg),
