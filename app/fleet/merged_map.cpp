@@ -117,7 +117,8 @@ MergedMap readMergedMap(const fs::path& dir, std::size_t max_points) {
       if (pcd.find("..") != std::string::npos || fs::path(pcd).is_absolute()) {
         throw io::InputError(index_file, 0, "tile file '" + pcd + "' outside the map folder");
       }
-      if (!fs::is_regular_file(dir / pcd)) {
+      std::error_code ec;  // a name too long for the file system names no file: missing
+      if (!fs::is_regular_file(dir / pcd, ec)) {
         throw io::InputError(index_file, 0, "tile file '" + pcd + "' is listed but missing");
       }
       files.push_back(dir / pcd);
