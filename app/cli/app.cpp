@@ -4,6 +4,9 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <filesystem>
+#include <system_error>
+
 #include "cli/interrupt.hpp"
 #include "odometry/error.hpp"
 
@@ -32,6 +35,11 @@ void setupLogging(const CommonOptions& common) {
   if (!google::IsGoogleLoggingInitialized()) google::InitGoogleLogging("gvio");
 }
 
+bool userPathError(const std::error_code& ec) {
+  return ec == std::errc::filename_too_long || ec == std::errc::not_a_directory ||
+         ec == std::errc::too_many_symbolic_link_levels || ec == std::errc::permission_denied;
+}
+
 // Bad input is the user's to fix (exit 2, one line); anything else is our bug (exit 1).
 int runGuarded(const std::function<int()>& run) {
   try {
@@ -39,6 +47,15 @@ int runGuarded(const std::function<int()>& run) {
   } catch (const InvalidInput& e) {
     spdlog::error("{}", e.what());
     return 2;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path the user gave that the file system refuses outright (too long, a file where a
+    // folder goes, a link loop, no permission) is theirs to fix, whichever query met it first.
+    if (userPathError(e.code())) {
+      spdlog::error("{}: {}", e.path1().string(), e.code().message());
+      return 2;
+    }
+    spdlog::error("internal error: {}", e.what());
+    return 1;
   } catch (const std::exception& e) {
     spdlog::error("internal error: {}", e.what());
     return 1;

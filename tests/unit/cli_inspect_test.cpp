@@ -131,6 +131,23 @@ TEST(CliUsage, UnknownFormatIsBadUsage) {
   EXPECT_THAT(r.out + r.err, HasSubstr("bogus"));
 }
 
+// A path the file system refuses outright is bad input (exit 2, one line naming it), not an
+// internal error, whichever command meets it first.
+TEST(CliUsage, APathTooLongForTheFileSystemIsBadInput) {
+  const std::string too_long =
+      (std::filesystem::temp_directory_path() / std::string(400, 'a')).string();
+  for (const std::string& args :
+       {"render --no-progress --run " + too_long + " --out " + too_long + ".png",
+        "inspect --no-progress --dataset " + too_long,
+        "eval --ref " + too_long + " --est " + too_long}) {
+    const auto r = test::runGvio(args);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_THAT(r.err, Not(HasSubstr("internal error"))) << args;
+    EXPECT_THAT(r.err, HasSubstr(std::string(400, 'a'))) << args;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+  }
+}
+
 TEST(CliUsage, MissingRequiredDatasetIsBadUsage) {
   EXPECT_EQ(test::runGvio("inspect").exit_code, 2);
   EXPECT_EQ(test::runGvio("").exit_code, 2);  // a subcommand is required
