@@ -169,13 +169,12 @@ void VioEstimator::Impl::addObservations(const WindowFrame& f, const TrackedFram
   }
 }
 
-void VioEstimator::Impl::anchorWindow() {
+void VioEstimator::Impl::anchorWindow(double tilt_sigma_rad) {
   StartPrior start;
   // Vision alone: the first pose is the gauge (all six degrees held). With the IMU aligned, tilt
   // is observable and keeps the uncertainty of its initial estimate.
   start.pose.tilt_rad =
-      imuActive() ? std::max(config.init_tilt_sigma_deg * M_PI / 180.0, start_tilt_sigma_rad)
-                  : 1e-4;
+      imuActive() ? std::max(config.init_tilt_sigma_deg * M_PI / 180.0, tilt_sigma_rad) : 1e-4;
   start.speed_bias = imuActive();
   start.velocity_mps = config.init_velocity_sigma_mps;
   start.acc_bias_mps2 = config.acc_bias_prior_mps2;

@@ -68,8 +68,9 @@ struct VioEstimator::Impl {
   // Restarts the window at the latest estimate (lost tracking, long coasting, time jumps).
   void restart(std::int64_t t_ns, const std::string& kind, const std::string& why,
                bool keep_imu_alignment);
-  // Anchors a window that just started (gauge and initial-state priors).
-  void anchorWindow();
+  // Anchors a window that just started (gauge and initial-state priors); with the IMU, the tilt
+  // prior's 1-sigma is the config's or tilt_sigma_rad (what the alignment knows), the larger.
+  void anchorWindow(double tilt_sigma_rad = 0.0);
   void event(std::int64_t t_ns, const std::string& kind, const std::string& message);
 
   // vio_initialization.cpp: gravity alignment of the visual window (static or in motion).
@@ -104,7 +105,7 @@ struct VioEstimator::Impl {
   // init_max_wait_s after the first such alignment.
   bool tiltCertainEnough(std::int64_t t_ns, double tilt_sigma_rad);
   void applyAlignment(const Eigen::Matrix3d& R_w_v, const std::vector<Eigen::Vector3d>& v_v,
-                      const ImuBias& bias);
+                      const ImuBias& bias, double tilt_sigma_rad = 0.0);
 
   [[nodiscard]] bool imuActive() const { return usesImu(config.mode) && imu_aligned; }
 
@@ -123,8 +124,6 @@ struct VioEstimator::Impl {
   bool waiting_reported = false;
   // The first alignment that was refused as too uncertain in tilt (-1: none since the last start).
   std::int64_t uncertain_alignment_since_ns = -1;
-  // The initial tilt's prior 1-sigma (rad): the config's, or the alignment's when it is larger.
-  double start_tilt_sigma_rad = 0.0;
   std::uint64_t next_uid = 1;
   std::int64_t last_frame_ns = -1;
   std::int64_t nominal_frame_ns = 0;

@@ -67,7 +67,7 @@ void VioEstimator::Impl::moveToStamps(const AlignmentResult& result) {
 
 void VioEstimator::Impl::applyAlignment(const Eigen::Matrix3d& R_w_v,
                                         const std::vector<Eigen::Vector3d>& v_v,
-                                        const ImuBias& bias) {
+                                        const ImuBias& bias, double tilt_sigma_rad) {
   auto& frames = window.frames();
   // Rotate about the oldest frame's position, so that a re-alignment (after a time jump, seeded
   // with the last estimate) keeps the trajectory continuous.
@@ -89,7 +89,7 @@ void VioEstimator::Impl::applyAlignment(const Eigen::Matrix3d& R_w_v,
   latest.valid = false;
   previous_pose.reset();
   imu_aligned = true;
-  anchorWindow();
+  anchorWindow(tilt_sigma_rad);
   ++counters.initializations;
 }
 
@@ -151,9 +151,7 @@ bool VioEstimator::Impl::motionInitialize(std::int64_t t_ns) {
   bias.gyr = result->gyr_bias;
   moveToStamps(*result);
   if (t_d_prior) setInitialTimeOffset(*result);
-  start_tilt_sigma_rad = result->tilt_sigma_rad;
-  applyAlignment(result->R_w_v, result->v_v, bias);
-  start_tilt_sigma_rad = 0.0;
+  applyAlignment(result->R_w_v, result->v_v, bias, result->tilt_sigma_rad);
   event(t_ns, "initialized",
         "visual-inertial alignment over " + std::to_string(frames.size()) +
             " frames: |g| before refinement " + fmt3(result->gravity_norm_before_refinement) +
