@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 
 #include "odometry/error.hpp"
 #include "run/pipeline_stages.hpp"
@@ -27,12 +28,20 @@ constexpr std::array kVioStages = {
     Stage{"map", runMapStage},    Stage{"report", writeReport},
 };
 
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
 void runStages(RunState& state) {
   state.stage = "gnss_ins";
   if (runGnssInsInstead(state)) return;
   for (const Stage& stage : kVioStages) {
     state.stage = stage.name;
+    const Clock::time_point start = Clock::now();
     stage.run(state);
+    state.stage_wall_s[stage.name] = secondsSince(start);
     if (&stage != &kVioStages.back()) stopIfInterrupted(state);
   }
 }
@@ -71,6 +80,7 @@ int runPipeline(const RunRequest& request, const RunConfig& config) {
   cv::setNumThreads(std::max(1, request.threads - 2));
   RunState state(request, config);
   loadDataset(state);
+  state.stage_wall_s["read"] = secondsSince(state.started);
   if (const int signal = request.pending_signal ? request.pending_signal() : 0; signal != 0) {
     spdlog::error("interrupted by {} while reading the dataset: nothing was written",
                   signalName(signal));

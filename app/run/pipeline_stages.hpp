@@ -2,6 +2,7 @@
 // The state gvio run's stages share and the stages themselves (run/pipeline.cpp calls them in
 // order). Each stage reads what the earlier ones left in RunState and adds its own part; files are
 // written by the stage that produces them, atomically.
+#include <chrono>
 #include <optional>
 #include <string>
 
@@ -38,6 +39,10 @@ struct RunState {
   Trajectory final_trajectory;  // trajectory.tum: loop-closed and/or fused; empty: VIO only
   bool georeferenced = false;   // final_trajectory is in local ENU
   nlohmann::json map_report;    // null without a map
+  // Wall time of the whole command from here, and of each stage done (seconds by stage name),
+  // for report.json: the VIO's own wall_s leaves out the reading and the stages after it.
+  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
+  nlohmann::json stage_wall_s = nlohmann::json::object();
 };
 
 // Creates the run folder (InvalidInput when it cannot).

@@ -257,6 +257,11 @@ TEST_F(CliRunEndToEnd, ReportHasTheContractFields) {
   }
   EXPECT_GT(r["timing_ms"]["total"]["mean"].get<double>(), 0.0);
   EXPECT_GT(r["wall_s"].get<double>(), 0.0);
+  // The whole command takes longer than its VIO stage, and each stage's time is there.
+  EXPECT_GT(r.value("run_wall_s", -1.0), r["wall_s"].get<double>());
+  const nlohmann::json stages = r.value("stage_wall_s", nlohmann::json::object());
+  for (const char* stage : {"read", "vio", "gnss", "loops", "trajectories", "map"})
+    EXPECT_GE(stages.value(stage, -1.0), 0.0) << stage;
   EXPECT_GT(r["peak_rss_mb"].get<double>(), 10.0);
   // --gnss auto with fixes in the dataset: the graph fusion.
   EXPECT_EQ(r["gnss"]["mode"], "graph");

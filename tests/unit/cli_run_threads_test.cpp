@@ -27,7 +27,7 @@ nlohmann::json withoutTimings(nlohmann::json j) {
     nlohmann::json out = nlohmann::json::object();
     for (auto& [key, value] : j.items()) {
       const bool timing = key.starts_with("ms") || key.find("_ms") != std::string::npos ||
-                          key == "timing_ms" || key == "wall_s" || key == "peak_rss_mb" ||
+                          key == "timing_ms" || key.ends_with("wall_s") || key == "peak_rss_mb" ||
                           key == "command_line" || key.ends_with("_mb");
       if (!timing) out[key] = withoutTimings(value);
     }
