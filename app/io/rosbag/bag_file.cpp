@@ -86,6 +86,24 @@ auto guarded(const std::string& what, F&& f) -> decltype(f()) {
   }
 }
 
+// The message as T: MessageInstance::instantiate gives null when the connection's md5sum is not
+// T's (a damaged record or another definition under the same type name), which is an error of
+// the bag, never a null to dereference. The md5sum itself is not quoted: it is the bag's bytes.
+template <typename T>
+boost::shared_ptr<T> instantiated(const rosbag::MessageInstance& m) {
+  boost::shared_ptr<T> msg = m.instantiate<T>();
+  if (!msg) {
+    // The type name is the bag's text: anything but printable ASCII becomes '?' (one line).
+    std::string type = m.getDataType();
+    for (char& c : type) {
+      if (c < 0x20 || c > 0x7e) c = '?';
+    }
+    throw BagError("message of unexpected type " + type +
+                   " (its md5sum is not that of the definition gvio reads)");
+  }
+  return msg;
+}
+
 }  // namespace
 
 struct BagReader::Impl {
@@ -114,9 +132,7 @@ struct BagReader::Impl {
       rosbag::View view(bag, rosbag::TopicQuery(topic));
       out.reserve(view.size());
       for (const rosbag::MessageInstance& m : view) {
-        const auto msg = m.instantiate<Msg>();
-        if (!msg) throw BagError("message of unexpected type " + m.getDataType());
-        out.push_back(convert(*msg, m));
+        out.push_back(convert(*instantiated<Msg>(m), m));
       }
       return out;
     });
@@ -184,7 +200,7 @@ std::vector<Stamps> BagReader::imageStamps(const std::string& topic) const {
     rosbag::View view(impl_->bag, rosbag::TopicQuery(topic));
     out.reserve(view.size());
     for (const rosbag::MessageInstance& m : view) {
-      out.push_back(stampsOf(m.instantiate<HeaderOnly>()->header, m));
+      out.push_back(stampsOf(instantiated<HeaderOnly>(m)->header, m));
       instances.push_back(m);
     }
     impl_->images.erase(topic);
@@ -203,14 +219,14 @@ ImageMessage BagReader::readImage(const std::string& topic, std::size_t index) c
   return guarded("reading image " + std::to_string(index) + " of " + topic, [&] {
     ImageMessage out;
     if (m.getDataType() == kCompressedImageType) {
-      const auto msg = m.instantiate<sensor_msgs::CompressedImage>();
+      const auto msg = instantiated<sensor_msgs::CompressedImage>(m);
       out.t = stampsOf(msg->header, m);
       out.compressed = true;
       out.format = msg->format;
       out.data = std::move(msg->data);
       return out;
     }
-    const auto msg = m.instantiate<sensor_msgs::Image>();
+    const auto msg = instantiated<sensor_msgs::Image>(m);
     out.t = stampsOf(msg->header, m);
     out.encoding = msg->encoding;
     out.width = msg->width;
