@@ -42,6 +42,61 @@ std::map<std::string, std::string> headerFields(const std::vector<unsigned char>
   return fields;
 }
 
+// Reads `count` bytes at `offset` (within the file: the caller checked).
+std::vector<unsigned char> readAt(std::ifstream& in, std::uint64_t offset, std::uint64_t count) {
+  std::vector<unsigned char> bytes(count);
+  in.seekg(static_cast<std::streamoff>(offset));
+  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(count));
+  if (!in) fail(offset, "cannot be read");
+  return bytes;
+}
+
+void checkChunkHeader(const std::map<std::string, std::string>& fields, std::uint64_t start,
+                      std::uint64_t data_len) {
+  const auto compression = fields.find("compression");
+  const auto declared = fields.find("size");
+  if (compression == fields.end() || declared == fields.end() || declared->second.size() != 4)
+    fail(start, "chunk header without compression or size");
+  const std::uint64_t unpacked =
+      littleEndian32(reinterpret_cast<const unsigned char*>(declared->second.data()));
+  if (unpacked > kMaxChunkBytes) fail(start, "chunk declares more than 1 GiB of messages");
+  if (compression->second == "none" && unpacked != data_len)
+    fail(start, "uncompressed chunk whose size differs from its data");
+}
+
+// The records in [begin, end) of the file, which they must fill exactly: every header's fields
+// well formed, and every connection record's data (its connection header, the same format) too.
+// At the top level the records inside each uncompressed chunk are walked as well. librosbag
+// parses all of these with ros::Header::parse, which trusts each field's length: a field longer
+// than its header made it read past its buffer (a fuzz finding).
+void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, bool top_level) {
+  std::uint64_t pos = begin;
+  auto readLength = [&](const char* what) {
+    if (end - pos < 4) fail(pos, what);
+    const std::vector<unsigned char> bytes = readAt(in, pos, 4);
+    pos += 4;
+    return std::uint64_t{littleEndian32(bytes.data())};
+  };
+  while (pos < end) {
+    const std::uint64_t start = pos;
+    const std::uint64_t header_len = readLength("truncated (no header length)");
+    if (header_len > end - pos) fail(start, "header runs past the end of its container");
+    const auto fields = headerFields(readAt(in, pos, header_len), start);
+    pos += header_len;
+    const std::uint64_t data_len = readLength("truncated (no data length)");
+    if (data_len > end - pos) fail(start, "data runs past the end of its container");
+    const auto op = fields.find("op");
+    const std::string kind = op == fields.end() ? std::string() : op->second;
+    if (kind == std::string(1, '\x07')) headerFields(readAt(in, pos, data_len), start);
+    if (kind == std::string(1, '\x05')) {
+      if (!top_level) fail(start, "chunk inside a chunk");
+      checkChunkHeader(fields, start, data_len);
+      if (fields.at("compression") == "none") walkRecords(in, pos, pos + data_len, false);
+    }
+    pos += data_len;
+  }
+}
+
 }  // namespace
 
 void checkBagRecords(const std::string& path) {
@@ -52,38 +107,7 @@ void checkBagRecords(const std::string& path) {
   std::string magic(v200.size(), '\0');
   in.seekg(0);
   if (!in.read(magic.data(), static_cast<std::streamsize>(magic.size())) || magic != v200) return;
-  std::uint64_t pos = v200.size();
-  unsigned char len[4];
-  auto readLength = [&](const char* what) {
-    if (size - pos < 4 || !in.read(reinterpret_cast<char*>(len), 4)) fail(pos, what);
-    pos += 4;
-    return std::uint64_t{littleEndian32(len)};
-  };
-  while (pos < size) {
-    const std::uint64_t start = pos;
-    const std::uint64_t header_len = readLength("truncated (no header length)");
-    if (header_len > size - pos) fail(start, "header runs past the end of the file");
-    std::vector<unsigned char> header(header_len);
-    in.read(reinterpret_cast<char*>(header.data()), static_cast<std::streamsize>(header_len));
-    pos += header_len;
-    const std::uint64_t data_len = readLength("truncated (no data length)");
-    if (data_len > size - pos) fail(start, "data runs past the end of the file");
-    const auto fields = headerFields(header, start);
-    const auto op = fields.find("op");
-    if (op != fields.end() && op->second == std::string(1, '\x05')) {  // a chunk
-      const auto compression = fields.find("compression");
-      const auto declared = fields.find("size");
-      if (compression == fields.end() || declared == fields.end() || declared->second.size() != 4)
-        fail(start, "chunk header without compression or size");
-      const std::uint64_t unpacked =
-          littleEndian32(reinterpret_cast<const unsigned char*>(declared->second.data()));
-      if (unpacked > kMaxChunkBytes) fail(start, "chunk declares more than 1 GiB of messages");
-      if (compression->second == "none" && unpacked != data_len)
-        fail(start, "uncompressed chunk whose size differs from its data");
-    }
-    pos += data_len;
-    in.seekg(static_cast<std::streamoff>(pos));
-  }
+  walkRecords(in, v200.size(), size, true);
 }
 
 }  // namespace gvio::io::bag
