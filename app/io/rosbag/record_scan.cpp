@@ -1,6 +1,9 @@
 #include "io/rosbag/record_scan.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <vector>
@@ -103,11 +106,27 @@ void checkBagRecords(const std::string& path) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw BagError("cannot open the file");
   const auto size = static_cast<std::uint64_t>(in.tellg());
-  const std::string v200 = "#ROSBAG V2.0\n";
-  std::string magic(v200.size(), '\0');
+  // The version line as librosbag reads it (Bag::readVersion: the first line, scanned with this
+  // format), so that every file it takes for version 2.0 is checked: "#ROSBAG V2.0" followed by
+  // other bytes before the newline is 2.0 to it too (a fuzz finding).
+  // A version line longer than any real one (12 bytes) is refused rather than read whole.
+  constexpr std::uint64_t kMaxVersionLine = 4096;
+  std::string head(std::min(size, kMaxVersionLine), '\0');
   in.seekg(0);
-  if (!in.read(magic.data(), static_cast<std::streamsize>(magic.size())) || magic != v200) return;
-  walkRecords(in, v200.size(), size, true);
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  const std::size_t newline = head.find('\n');
+  if (newline == std::string::npos) {
+    if (head.rfind("#ROS", 0) == 0 && size > kMaxVersionLine)
+      throw BagError("no version line (no newline in the first 4096 bytes)");
+    return;  // no records after it: librosbag refuses the file
+  }
+  const std::string line = head.substr(0, newline);
+  std::array<char, 100> type{};
+  int major = -1, minor = -1;
+  if (std::sscanf(line.c_str(), "#ROS%99s V%d.%d", type.data(), &major, &minor) != 3) return;
+  if (major != 2 || minor != 0) return;
+  in.clear();
+  walkRecords(in, line.size() + 1, size, true);
 }
 
 }  // namespace gvio::io::bag
