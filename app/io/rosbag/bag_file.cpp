@@ -93,12 +93,9 @@ template <typename T>
 boost::shared_ptr<T> instantiated(const rosbag::MessageInstance& m) {
   boost::shared_ptr<T> msg = m.instantiate<T>();
   if (!msg) {
-    // The type name is the bag's text: anything but printable ASCII becomes '?' (one line).
-    std::string type = m.getDataType();
-    for (char& c : type) {
-      if (c < 0x20 || c > 0x7e) c = '?';
-    }
-    throw BagError("message of unexpected type " + type +
+    // The type name is the bag's text; InputError, which every BagError becomes, escapes its
+    // control bytes so that the message stays one line.
+    throw BagError("message of unexpected type " + m.getDataType() +
                    " (its md5sum is not that of the definition gvio reads)");
   }
   return msg;
