@@ -1,14 +1,15 @@
 #include "odometry/marginalization.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <unordered_set>
 #include <utility>
 
 #include "odometry/error.hpp"
+#include "odometry/schur_complement.hpp"
 
 namespace gvio::odometry {
 namespace {
@@ -49,34 +50,6 @@ void applyLoss(const ceres::LossFunction& loss, Eigen::VectorXd& r, Eigen::Matri
   const double alpha_sq_norm = alpha / sq_norm;
   J = sqrt_rho1 * (J - alpha_sq_norm * r * (r.transpose() * J));
   r *= sqrt_rho1 / (1.0 - alpha);
-}
-
-// Eigenpairs of the symmetric PSD matrix A with eigenvalues above the options' threshold
-// (relative to max(scale_floor, largest eigenvalue)).
-struct Spectrum {
-  Eigen::MatrixXd V;  // columns: eigenvectors kept
-  Eigen::VectorXd s;  // their eigenvalues, > 0
-};
-
-Spectrum significantSpectrum(const Eigen::MatrixXd& A, double scale_floor,
-                             const MarginalizationOptions& options) {
-  Spectrum out;
-  if (A.rows() == 0) return out;
-  const Eigen::MatrixXd sym = 0.5 * (A + A.transpose());
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(sym);
-  if (solver.info() != Eigen::Success) {
-    throw std::runtime_error("marginalization: eigen-decomposition failed");
-  }
-  const Eigen::VectorXd& values = solver.eigenvalues();  // ascending
-  const double scale = std::max(scale_floor, values(values.size() - 1));
-  const double threshold = std::max(options.eigenvalue_absolute_threshold,
-                                    options.eigenvalue_relative_threshold * scale);
-  Eigen::Index first = 0;
-  while (first < values.size() && !(values(first) > threshold && values(first) > 0.0)) ++first;
-  const Eigen::Index kept = values.size() - first;
-  out.V = solver.eigenvectors().rightCols(kept);
-  out.s = values.tail(kept);
-  return out;
 }
 
 }  // namespace
@@ -193,6 +166,48 @@ void Marginalizer::markForRemoval(const double* block) {
   state(block).remove = true;
 }
 
+std::vector<LeavingBlock> Marginalizer::leavingBlocks(
+    const std::unordered_map<const double*, int>& offset) const {
+  std::vector<const double*> leaving;
+  for (const double* block : order_) {
+    if (blocks_.at(block).remove) leaving.push_back(block);
+  }
+  std::unordered_map<const double*, std::vector<const double*>> shares;
+  std::vector<const double*> named;
+  for (const ResidualEntry& res : residuals_) {
+    named.clear();
+    for (const double* block : res.blocks) {
+      if (blocks_.at(block).remove) named.push_back(block);
+    }
+    for (const double* a : named) {
+      for (const double* b : named) {
+        if (a != b) shares[a].push_back(b);
+      }
+    }
+  }
+  const auto tangent = [&](const double* block) {
+    const BlockState& s = blocks_.at(block);
+    return tangentSizeOf(s.ambient_size, s.manifold);
+  };
+  std::vector<const double*> by_size = leaving;
+  std::stable_sort(by_size.begin(), by_size.end(),
+                   [&](const double* a, const double* b) { return tangent(a) < tangent(b); });
+  std::unordered_set<const double*> isolated;
+  for (const double* block : by_size) {
+    const auto it = shares.find(block);
+    const bool alone = it == shares.end() ||
+                       std::none_of(it->second.begin(), it->second.end(),
+                                    [&](const double* other) { return isolated.count(other) > 0; });
+    if (alone) isolated.insert(block);
+  }
+  std::vector<LeavingBlock> out;
+  out.reserve(leaving.size());
+  for (const double* block : leaving) {
+    out.push_back({offset.at(block), tangent(block), isolated.count(block) > 0});
+  }
+  return out;
+}
+
 std::shared_ptr<const MarginalizationPrior> Marginalizer::marginalize() const {
   for (const auto& [block, s] : blocks_) {
     if (s.remove && s.ambient_size == 0) {
@@ -278,19 +293,10 @@ std::shared_ptr<const MarginalizationPrior> Marginalizer::marginalize() const {
     }
   }
 
-  // Schur complement with the pseudo-inverse H_mm^+ = V S^-1 V^T (VINS-Mono): H_mm is singular
-  // when a leaving block has a direction no residual constrains. W = H_rm V S^-1/2 keeps H*
-  // symmetric by construction: H* = H_rr - W W^T, g* = g_r - W S^-1/2 V^T g_m.
   const int nr = n - m;
-  Eigen::MatrixXd H_star = H.bottomRightCorner(nr, nr);
-  Eigen::VectorXd g_star = g.tail(nr);
-  if (m > 0) {
-    const Spectrum mm = significantSpectrum(H.topLeftCorner(m, m), 0.0, options_);
-    const Eigen::VectorXd inv_sqrt = mm.s.cwiseSqrt().cwiseInverse();
-    const Eigen::MatrixXd W = H.bottomLeftCorner(nr, m) * mm.V * inv_sqrt.asDiagonal();
-    H_star -= W * W.transpose();
-    g_star -= W * inv_sqrt.cwiseProduct(mm.V.transpose() * g.head(m));
-  }
+  const SchurComplement star = schurComplement(H, g, m, leavingBlocks(offset), options_);
+  const Eigen::MatrixXd& H_star = star.H;
+  const Eigen::VectorXd& g_star = star.g;
 
   // H* = V S V^T -> J* = S^1/2 V^T, r0 = S^-1/2 V^T g*. Dropping the null space of H* (gauge
   // directions) keeps r0 finite; J*^T r0 is g* projected onto the range of H*.

@@ -26,6 +26,8 @@
 #include <ceres/loss_function.h>
 #include <ceres/manifold.h>
 
+#include "odometry/schur_complement.hpp"
+
 namespace gvio::odometry {
 
 // The result of one marginalisation: r(x) = r0 + J * [Minus(x_k, x0_k)]_k over the kept blocks.
@@ -113,6 +115,11 @@ class Marginalizer {
   };
 
   BlockState& state(const double* block);
+  // The leaving blocks in column order (`offset`: first tangent column of each block), those
+  // that share no residual with one another marked isolated: greedily, smallest first, so that
+  // every landmark's inverse depth is isolated and the oldest pose it shares residuals with is not.
+  [[nodiscard]] std::vector<LeavingBlock> leavingBlocks(
+      const std::unordered_map<const double*, int>& offset) const;
 
   MarginalizationOptions options_;
   std::unordered_map<const double*, BlockState> blocks_;

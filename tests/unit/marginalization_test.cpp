@@ -485,6 +485,41 @@ TEST(Marginalization, RemarginalizingPreviousPriorMatchesFullSchur) {
   expectPrior(prior2, expected, 1e-9 * expected.H.cwiseAbs().maxCoeff());
 }
 
+// Leaving scalars that share residuals only with a leaving pose-like block are eliminated on their
+// own (odometry/schur_complement.hpp); two that share a residual with each other must not be.
+// Either way the prior is the Schur complement of all leaving blocks at once.
+TEST(Marginalization, LeavingBlocksThatShareResidualsAreEliminatedTogether) {
+  std::array<double, 1> a{0.3}, b{-0.2}, c{1.1};
+  std::array<double, 2> p{0.5, -0.4}, k1{0.1, 0.2}, k2{-0.3, 0.7};
+  const auto cost = [](std::vector<Eigen::MatrixXd> A, int rows, double shift) {
+    Eigen::VectorXd z(rows);
+    for (int i = 0; i < rows; ++i) z(i) = shift + 0.1 * i;
+    for (std::size_t k = 0; k < A.size(); ++k) {
+      for (Eigen::Index i = 0; i < A[k].size(); ++i) {
+        A[k](i) = 1.0 + 0.37 * static_cast<double>(k + 1) *
+                            std::sin(1.7 * static_cast<double>(i) + shift);
+      }
+    }
+    return std::make_shared<LinearCost>(std::move(A), z);
+  };
+  const auto block = [](int rows, int cols) { return Eigen::MatrixXd(rows, cols); };
+  const std::vector<Term> terms = {
+      {cost({block(2, 1), block(2, 2), block(2, 2)}, 2, 0.1), {a.data(), p.data(), k1.data()}},
+      {cost({block(2, 1), block(2, 2), block(2, 2)}, 2, 0.4), {b.data(), p.data(), k2.data()}},
+      {cost({block(1, 1), block(1, 1)}, 1, 0.9), {a.data(), b.data()}},
+      {cost({block(1, 1)}, 1, 1.3), {c.data()}},
+      {cost({block(2, 1), block(2, 2)}, 2, 1.6), {c.data(), k1.data()}},
+      {cost({block(4, 2), block(4, 2), block(4, 2)}, 4, 2.2), {p.data(), k1.data(), k2.data()}},
+      {cost({block(1, 1)}, 1, 2.9), {a.data()}},
+      {cost({block(1, 1)}, 1, 3.4), {b.data()}}};
+  const auto prior = marginalize(terms, {a.data(), b.data(), c.data(), p.data()});
+  const Linearization expected =
+      schur(evaluateWithCeres(*problemOf(terms),
+                              {a.data(), p.data(), b.data(), c.data(), k1.data(), k2.data()}),
+            5);
+  expectPrior(prior, expected, 1e-9 * expected.H.cwiseAbs().maxCoeff());
+}
+
 }  // namespace
 }  // namespace gvio::odometry
 
