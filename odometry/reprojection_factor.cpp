@@ -54,10 +54,15 @@ bool anchoredResidual(const Eigen::Vector3d& u_a, const Eigen::Isometry3d& T_b_c
   const Eigen::Matrix3d R_co_b = observer.T_b_c.rotation().transpose();
   const Eigen::Vector3d P_co = R_co_b * (P_bj - observer.T_b_c.translation());
 
+  // A cost-only evaluation (Ceres' candidate steps, about half of them) skips the Jacobians.
+  const bool jacobians = J_pose_i != nullptr || J_pose_j != nullptr || J_ca != nullptr;
   Eigen::Vector2d r_value;
   Eigen::Matrix<double, 2, 3> J_proj;
-  if (!projectResidual(observer, P_co, px, inv_sigma, r_value, &J_proj)) return false;
+  if (!projectResidual(observer, P_co, px, inv_sigma, r_value, jacobians ? &J_proj : nullptr)) {
+    return false;
+  }
   Eigen::Map<Eigen::Vector2d>{residuals} = r_value;
+  if (!jacobians) return true;
 
   // Chain rule through P_co = R_co_b R_j^T (P_w - p_j) - ...; perturbations R Exp(dphi), p + R dp.
   const Eigen::Matrix<double, 2, 3> J_w = J_proj * R_co_b * R_j.transpose();
@@ -83,7 +88,7 @@ bool ReprojectionFactor::Evaluate(double const* const* parameters, double* resid
   const bool want = jacobians != nullptr;
   if (!anchoredResidual(bearing_, T_b_ca_, observer_, px_, inv_sigma_, parameters[0], parameters[1],
                         rho, residuals, want ? jacobians[0] : nullptr,
-                        want ? jacobians[1] : nullptr, &J_ca)) {
+                        want ? jacobians[1] : nullptr, want ? &J_ca : nullptr)) {
     return false;
   }
   if (want && jacobians[2] != nullptr) {

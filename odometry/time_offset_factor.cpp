@@ -36,7 +36,7 @@ bool ReprojectionTimeOffsetFactor::Evaluate(double const* const* parameters, dou
   Eigen::Matrix<double, 2, 3> J_ca;
   if (!anchoredResidual(u_a, anchor_camera_.T_b_c, observer_, z, inv_sigma_, parameters[0],
                         parameters[1], rho, residuals, want ? jacobians[0] : nullptr,
-                        want ? jacobians[1] : nullptr, &J_ca)) {
+                        want ? jacobians[1] : nullptr, want ? &J_ca : nullptr)) {
     return false;
   }
   if (!want) return true;
