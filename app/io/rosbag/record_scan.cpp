@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <vector>
 
 #include "io/rosbag/bag_file.hpp"
@@ -72,7 +73,12 @@ void checkChunkHeader(const std::map<std::string, std::string>& fields, std::uin
 // At the top level the records inside each uncompressed chunk are walked as well. librosbag
 // parses all of these with ros::Header::parse, which trusts each field's length: a field longer
 // than its header made it read past its buffer (a fuzz finding).
-void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, bool top_level) {
+// `top` (at the top level only) gets every record's offset and header fields: librosbag jumps to
+// offsets the file states (the file header's index_pos, each chunk info's chunk_pos), which must
+// be records this walk checked.
+using TopRecords = std::map<std::uint64_t, std::map<std::string, std::string>>;
+void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, TopRecords* top) {
+  const bool top_level = top != nullptr;
   std::uint64_t pos = begin;
   auto readLength = [&](const char* what) {
     if (end - pos < 4) fail(pos, what);
@@ -94,9 +100,45 @@ void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, bool
     if (kind == std::string(1, '\x05')) {
       if (!top_level) fail(start, "chunk inside a chunk");
       checkChunkHeader(fields, start, data_len);
-      if (fields.at("compression") == "none") walkRecords(in, pos, pos + data_len, false);
+      if (fields.at("compression") == "none") walkRecords(in, pos, pos + data_len, nullptr);
     }
+    if (top_level) (*top)[start] = fields;
     pos += data_len;
+  }
+}
+
+// An 8-byte little-endian header field, or nullopt when absent or of another size.
+std::optional<std::uint64_t> field64(const std::map<std::string, std::string>& fields,
+                                     const char* name) {
+  const auto it = fields.find(name);
+  if (it == fields.end() || it->second.size() != 8) return std::nullopt;
+  const auto* p = reinterpret_cast<const unsigned char*>(it->second.data());
+  return std::uint64_t{littleEndian32(p)} | std::uint64_t{littleEndian32(p + 4)} << 32;
+}
+
+// librosbag reads the index from the file header's index_pos and each chunk from its chunk info's
+// chunk_pos: a position that is not the start of a checked record had it parse whatever bytes lie
+// there (a length of 2.3 GB it then allocated; a fuzz finding). index_pos 0 is an unindexed bag,
+// which librosbag reports itself.
+void checkJumps(const TopRecords& top, std::uint64_t file_size) {
+  const auto opOf = [](const std::map<std::string, std::string>& fields) {
+    const auto op = fields.find("op");
+    return op == fields.end() || op->second.size() != 1 ? '\0' : op->second[0];
+  };
+  for (const auto& [offset, fields] : top) {
+    const char op = opOf(fields);
+    if (op == '\x03') {
+      const auto index_pos = field64(fields, "index_pos");
+      if (index_pos && *index_pos != 0 && *index_pos != file_size && top.count(*index_pos) == 0)
+        fail(offset, "file header's index_pos " + std::to_string(*index_pos) +
+                         " is not the start of a record");
+    }
+    if (op == '\x06') {
+      const auto chunk_pos = field64(fields, "chunk_pos");
+      const auto chunk = chunk_pos ? top.find(*chunk_pos) : top.end();
+      if (chunk == top.end() || opOf(chunk->second) != '\x05')
+        fail(offset, "chunk info whose chunk_pos is not the start of a chunk");
+    }
   }
 }
 
@@ -126,7 +168,9 @@ void checkBagRecords(const std::string& path) {
   if (std::sscanf(line.c_str(), "#ROS%99s V%d.%d", type.data(), &major, &minor) != 3) return;
   if (major != 2 || minor != 0) return;
   in.clear();
-  walkRecords(in, line.size() + 1, size, true);
+  TopRecords top;
+  walkRecords(in, line.size() + 1, size, &top);
+  checkJumps(top, size);
 }
 
 }  // namespace gvio::io::bag
