@@ -73,11 +73,44 @@ void checkChunkHeader(const std::map<std::string, std::string>& fields, std::uin
 // At the top level the records inside each uncompressed chunk are walked as well. librosbag
 // parses all of these with ros::Header::parse, which trusts each field's length: a field longer
 // than its header made it read past its buffer (a fuzz finding).
+// The records inside an uncompressed chunk: offset from the chunk's data start -> op.
+using ChunkRecords = std::map<std::uint64_t, std::string>;
+
+// A 4-byte little-endian header field, or nullopt when absent or of another size.
+std::optional<std::uint32_t> field32(const std::map<std::string, std::string>& fields,
+                                     const char* name) {
+  const auto it = fields.find(name);
+  if (it == fields.end() || it->second.size() != 4) return std::nullopt;
+  return littleEndian32(reinterpret_cast<const unsigned char*>(it->second.data()));
+}
+
+// An index data record (op 0x04) follows its chunk and lists (time, offset) entries of 12 bytes;
+// librosbag reads a message record at each offset of the chunk's data as it stands (an offset
+// into the middle of a record made it read a header past its buffer: a fuzz finding). Entries
+// of a compressed chunk are not checked: librosbag decompresses that chunk itself.
+void checkIndexData(const std::map<std::string, std::string>& fields,
+                    const std::vector<unsigned char>& data, std::uint64_t start, bool after_chunk,
+                    const std::optional<ChunkRecords>& chunk) {
+  if (!after_chunk) fail(start, "index data record before any chunk");
+  if (!chunk) return;
+  const auto count = field32(fields, "count");
+  if (!count || data.size() != std::uint64_t{12} * *count)
+    fail(start, "index data whose size is not 12 bytes per entry");
+  for (std::uint64_t i = 0; i < *count; ++i) {
+    const std::uint32_t offset = littleEndian32(&data[12 * i + 8]);
+    const auto record = chunk->find(offset);
+    if (record == chunk->end() || record->second != std::string(1, '\x02'))
+      fail(start, "index entry whose offset " + std::to_string(offset) +
+                      " is not a message record of its chunk");
+  }
+}
+
 // `top` (at the top level only) gets every record's offset and header fields: librosbag jumps to
 // offsets the file states (the file header's index_pos, each chunk info's chunk_pos), which must
-// be records this walk checked.
+// be records this walk checked. `inner` (inside a chunk only) gets the chunk's records.
 using TopRecords = std::map<std::uint64_t, std::map<std::string, std::string>>;
-void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, TopRecords* top) {
+void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, TopRecords* top,
+                 ChunkRecords* inner) {
   const bool top_level = top != nullptr;
   std::uint64_t pos = begin;
   auto readLength = [&](const char* what) {
@@ -86,6 +119,8 @@ void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, TopR
     pos += 4;
     return std::uint64_t{littleEndian32(bytes.data())};
   };
+  bool after_chunk = false;
+  std::optional<ChunkRecords> last_chunk;  // the last chunk's records, when uncompressed
   while (pos < end) {
     const std::uint64_t start = pos;
     const std::uint64_t header_len = readLength("truncated (no header length)");
@@ -100,9 +135,18 @@ void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, TopR
     if (kind == std::string(1, '\x05')) {
       if (!top_level) fail(start, "chunk inside a chunk");
       checkChunkHeader(fields, start, data_len);
-      if (fields.at("compression") == "none") walkRecords(in, pos, pos + data_len, nullptr);
+      after_chunk = true;
+      last_chunk.reset();
+      if (fields.at("compression") == "none") {
+        ChunkRecords records;
+        walkRecords(in, pos, pos + data_len, nullptr, &records);
+        last_chunk = std::move(records);
+      }
     }
+    if (top_level && kind == std::string(1, '\x04'))
+      checkIndexData(fields, readAt(in, pos, data_len), start, after_chunk, last_chunk);
     if (top_level) (*top)[start] = fields;
+    if (inner != nullptr) (*inner)[start - begin] = kind;
     pos += data_len;
   }
 }
@@ -169,7 +213,7 @@ void checkBagRecords(const std::string& path) {
   if (major != 2 || minor != 0) return;
   in.clear();
   TopRecords top;
-  walkRecords(in, line.size() + 1, size, &top);
+  walkRecords(in, line.size() + 1, size, &top, nullptr);
   checkJumps(top, size);
 }
 
