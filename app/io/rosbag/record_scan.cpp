@@ -210,7 +210,12 @@ void checkBagRecords(const std::string& path) {
   std::array<char, 100> type{};
   int major = -1, minor = -1;
   if (std::sscanf(line.c_str(), "#ROS%99s V%d.%d", type.data(), &major, &minor) != 3) return;
-  if (major != 2 || minor != 0) return;
+  // librosbag also reads format 1.2 (ROS 2010) with the same trust in every length (a 1.2 file
+  // header asked it for 3.4 GB; a fuzz finding). Only 2.0, which rosbag has written since, is read.
+  if (major != 2 || minor != 0) {
+    throw BagError("ROS bag format " + std::to_string(major) + "." + std::to_string(minor) +
+                   ": only format 2.0 is read");
+  }
   in.clear();
   TopRecords top;
   walkRecords(in, line.size() + 1, size, &top, nullptr);

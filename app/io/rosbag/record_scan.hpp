@@ -10,8 +10,8 @@ namespace gvio::io::bag {
 
 // Throws BagError (bag_file.hpp) for a record that overruns the file, a malformed record header,
 // a chunk that declares more than 1 GiB uncompressed (or, uncompressed, a size other than its
-// data), or an index_pos / chunk_pos that is not the start of a record (of a chunk). Files of other
-// format versions are left to the library.
+// data), an index_pos / chunk_pos that is not the start of a record (of a chunk), or a version
+// line of another format than 2.0. A file without a ROS version line is left to the library.
 void checkBagRecords(const std::string& path);
 
 }  // namespace gvio::io::bag
