@@ -192,21 +192,19 @@ void checkBagRecords(const std::string& path) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw BagError("cannot open the file");
   const auto size = static_cast<std::uint64_t>(in.tellg());
-  // The version line as librosbag reads it (Bag::readVersion: the first line, scanned with this
-  // format), so that every file it takes for version 2.0 is checked: "#ROSBAG V2.0" followed by
-  // other bytes before the newline is 2.0 to it too (a fuzz finding).
-  // A version line longer than any real one (12 bytes) is refused rather than read whole.
-  constexpr std::uint64_t kMaxVersionLine = 4096;
-  std::string head(std::min(size, kMaxVersionLine), '\0');
+  // The version line as librosbag reads it, so that every file it takes for version 2.0 is
+  // checked from where it reads the file header: Bag::readVersion scans the line with the format
+  // below, and ChunkedFile::getline reads it with fgets into 1024 bytes and goes on from the end
+  // of the C string it got: after the newline, after 1023 bytes without one, or at a NUL byte.
+  // "#ROSBAG V2.0" followed by other bytes, or by a NUL and no newline at all, is 2.0 to it too
+  // (two fuzz findings: its header parser read past its buffer, and allocated 4 GB).
+  constexpr std::uint64_t kFgetsBytes = 1023;
+  std::string line(std::min(size, kFgetsBytes), '\0');
   in.seekg(0);
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  const std::size_t newline = head.find('\n');
-  if (newline == std::string::npos) {
-    if (head.rfind("#ROS", 0) == 0 && size > kMaxVersionLine)
-      throw BagError("no version line (no newline in the first 4096 bytes)");
-    return;  // no records after it: librosbag refuses the file
-  }
-  const std::string line = head.substr(0, newline);
+  in.read(line.data(), static_cast<std::streamsize>(line.size()));
+  if (const std::size_t newline = line.find('\n'); newline != std::string::npos)
+    line.resize(newline + 1);
+  if (const std::size_t nul = line.find('\0'); nul != std::string::npos) line.resize(nul);
   std::array<char, 100> type{};
   int major = -1, minor = -1;
   if (std::sscanf(line.c_str(), "#ROS%99s V%d.%d", type.data(), &major, &minor) != 3) return;
@@ -218,7 +216,7 @@ void checkBagRecords(const std::string& path) {
   }
   in.clear();
   TopRecords top;
-  walkRecords(in, line.size() + 1, size, &top, nullptr);
+  walkRecords(in, line.size(), size, &top, nullptr);
   checkJumps(top, size);
 }
 
