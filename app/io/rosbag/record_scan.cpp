@@ -68,11 +68,6 @@ void checkChunkHeader(const std::map<std::string, std::string>& fields, std::uin
     fail(start, "uncompressed chunk whose size differs from its data");
 }
 
-// The records in [begin, end) of the file, which they must fill exactly: every header's fields
-// well formed, and every connection record's data (its connection header, the same format) too.
-// At the top level the records inside each uncompressed chunk are walked as well. librosbag
-// parses all of these with ros::Header::parse, which trusts each field's length: a field longer
-// than its header made it read past its buffer (a fuzz finding).
 // The records inside an uncompressed chunk: offset from the chunk's data start -> op.
 using ChunkRecords = std::map<std::uint64_t, std::string>;
 
@@ -105,6 +100,11 @@ void checkIndexData(const std::map<std::string, std::string>& fields,
   }
 }
 
+// The records in [begin, end) of the file, which they must fill exactly: every header's fields
+// well formed, and every connection record's data (its connection header, the same format) too.
+// At the top level the records inside each uncompressed chunk are walked as well. librosbag
+// parses all of these with ros::Header::parse, which trusts each field's length: a field longer
+// than its header made it read past its buffer (a fuzz finding).
 // `top` (at the top level only) gets every record's offset and header fields: librosbag jumps to
 // offsets the file states (the file header's index_pos, each chunk info's chunk_pos), which must
 // be records this walk checked. `inner` (inside a chunk only) gets the chunk's records.
