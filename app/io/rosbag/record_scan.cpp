@@ -55,36 +55,61 @@ std::vector<unsigned char> readAt(std::ifstream& in, std::uint64_t offset, std::
   return bytes;
 }
 
-void checkChunkHeader(const std::map<std::string, std::string>& fields, std::uint64_t start,
-                      std::uint64_t data_len) {
-  const auto compression = fields.find("compression");
-  const auto declared = fields.find("size");
-  if (compression == fields.end() || declared == fields.end() || declared->second.size() != 4)
-    fail(start, "chunk header without compression or size");
-  const std::uint64_t unpacked =
-      littleEndian32(reinterpret_cast<const unsigned char*>(declared->second.data()));
-  if (unpacked > kMaxChunkBytes) fail(start, "chunk declares more than 1 GiB of messages");
-  if (compression->second == "none" && unpacked != data_len)
-    fail(start, "uncompressed chunk whose size differs from its data");
+using Fields = std::map<std::string, std::string>;
+// Record ops (http://wiki.ros.org/Bags/Format/2.0).
+constexpr char kOpMessageData = 0x02;
+constexpr char kOpFileHeader = 0x03;
+constexpr char kOpIndexData = 0x04;
+constexpr char kOpChunk = 0x05;
+constexpr char kOpChunkInfo = 0x06;
+constexpr char kOpConnection = 0x07;
+
+// A record's op, or '\0' when its header has none of one byte.
+char opOf(const Fields& fields) {
+  const auto op = fields.find("op");
+  return op == fields.end() || op->second.size() != 1 ? '\0' : op->second[0];
 }
 
-// The records inside an uncompressed chunk: offset from the chunk's data start -> op.
-using ChunkRecords = std::map<std::uint64_t, std::string>;
-
 // A 4-byte little-endian header field, or nullopt when absent or of another size.
-std::optional<std::uint32_t> field32(const std::map<std::string, std::string>& fields,
-                                     const char* name) {
+std::optional<std::uint32_t> field32(const Fields& fields, const char* name) {
   const auto it = fields.find(name);
   if (it == fields.end() || it->second.size() != 4) return std::nullopt;
   return littleEndian32(reinterpret_cast<const unsigned char*>(it->second.data()));
 }
 
+// An 8-byte little-endian header field, or nullopt when absent or of another size.
+std::optional<std::uint64_t> field64(const Fields& fields, const char* name) {
+  const auto it = fields.find(name);
+  if (it == fields.end() || it->second.size() != 8) return std::nullopt;
+  const auto* p = reinterpret_cast<const unsigned char*>(it->second.data());
+  return std::uint64_t{littleEndian32(p)} | std::uint64_t{littleEndian32(p + 4)} << 32;
+}
+
+void checkChunkHeader(const Fields& fields, std::uint64_t start, std::uint64_t data_len) {
+  const auto compression = fields.find("compression");
+  const auto unpacked = field32(fields, "size");
+  if (compression == fields.end() || !unpacked)
+    fail(start, "chunk header without compression or size");
+  if (*unpacked > kMaxChunkBytes) fail(start, "chunk declares more than 1 GiB of messages");
+  if (compression->second == "none" && *unpacked != data_len)
+    fail(start, "uncompressed chunk whose size differs from its data");
+}
+
+// Records by their byte offset in the file: their ops.
+using RecordOps = std::map<std::uint64_t, char>;
+
+// The records of the last chunk, when it is uncompressed (its data starts at `begin`).
+struct ChunkRecords {
+  std::uint64_t begin = 0;
+  RecordOps ops;
+};
+
 // An index data record (op 0x04) follows its chunk and lists (time, offset) entries of 12 bytes;
 // librosbag reads a message record at each offset of the chunk's data as it stands (an offset
 // into the middle of a record made it read a header past its buffer: a fuzz finding). Entries
 // of a compressed chunk are not checked: librosbag decompresses that chunk itself.
-void checkIndexData(const std::map<std::string, std::string>& fields,
-                    const std::vector<unsigned char>& data, std::uint64_t start, bool after_chunk,
+void checkIndexData(const Fields& fields, const std::vector<unsigned char>& data,
+                    std::uint64_t start, bool after_chunk,
                     const std::optional<ChunkRecords>& chunk) {
   if (!after_chunk) fail(start, "index data record before any chunk");
   if (!chunk) return;
@@ -93,8 +118,8 @@ void checkIndexData(const std::map<std::string, std::string>& fields,
     fail(start, "index data whose size is not 12 bytes per entry");
   for (std::uint64_t i = 0; i < *count; ++i) {
     const std::uint32_t offset = littleEndian32(&data[12 * i + 8]);
-    const auto record = chunk->find(offset);
-    if (record == chunk->end() || record->second != std::string(1, '\x02'))
+    const auto record = chunk->ops.find(chunk->begin + offset);
+    if (record == chunk->ops.end() || record->second != kOpMessageData)
       fail(start, "index entry whose offset " + std::to_string(offset) +
                       " is not a message record of its chunk");
   }
@@ -104,14 +129,13 @@ void checkIndexData(const std::map<std::string, std::string>& fields,
 // well formed, and every connection record's data (its connection header, the same format) too.
 // At the top level the records inside each uncompressed chunk are walked as well. librosbag
 // parses all of these with ros::Header::parse, which trusts each field's length: a field longer
-// than its header made it read past its buffer (a fuzz finding).
-// `top` (at the top level only) gets every record's offset and header fields: librosbag jumps to
-// offsets the file states (the file header's index_pos, each chunk info's chunk_pos), which must
-// be records this walk checked. `inner` (inside a chunk only) gets the chunk's records.
-using TopRecords = std::map<std::uint64_t, std::map<std::string, std::string>>;
-void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, TopRecords* top,
-                 ChunkRecords* inner) {
-  const bool top_level = top != nullptr;
+// than its header made it read past its buffer (a fuzz finding). `ops` gets every record walked
+// at this level; `jumps` (at the top level only) the file header and chunk info records, whose
+// index_pos / chunk_pos librosbag seeks to.
+using Jumps = std::vector<std::pair<std::uint64_t, Fields>>;
+void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, RecordOps& ops,
+                 Jumps* jumps) {
+  const bool top_level = jumps != nullptr;
   std::uint64_t pos = begin;
   auto readLength = [&](const char* what) {
     if (end - pos < 4) fail(pos, what);
@@ -120,67 +144,52 @@ void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, TopR
     return std::uint64_t{littleEndian32(bytes.data())};
   };
   bool after_chunk = false;
-  std::optional<ChunkRecords> last_chunk;  // the last chunk's records, when uncompressed
+  std::optional<ChunkRecords> last_chunk;
   while (pos < end) {
     const std::uint64_t start = pos;
     const std::uint64_t header_len = readLength("truncated (no header length)");
     if (header_len > end - pos) fail(start, "header runs past the end of its container");
-    const auto fields = headerFields(readAt(in, pos, header_len), start);
+    const Fields fields = headerFields(readAt(in, pos, header_len), start);
     pos += header_len;
     const std::uint64_t data_len = readLength("truncated (no data length)");
     if (data_len > end - pos) fail(start, "data runs past the end of its container");
-    const auto op = fields.find("op");
-    const std::string kind = op == fields.end() ? std::string() : op->second;
-    if (kind == std::string(1, '\x07')) headerFields(readAt(in, pos, data_len), start);
-    if (kind == std::string(1, '\x05')) {
+    const char op = opOf(fields);
+    if (op == kOpConnection) headerFields(readAt(in, pos, data_len), start);
+    if (op == kOpChunk) {
       if (!top_level) fail(start, "chunk inside a chunk");
       checkChunkHeader(fields, start, data_len);
       after_chunk = true;
       last_chunk.reset();
       if (fields.at("compression") == "none") {
-        ChunkRecords records;
-        walkRecords(in, pos, pos + data_len, nullptr, &records);
-        last_chunk = std::move(records);
+        ChunkRecords chunk{pos, {}};
+        walkRecords(in, pos, pos + data_len, chunk.ops, nullptr);
+        last_chunk = std::move(chunk);
       }
     }
-    if (top_level && kind == std::string(1, '\x04'))
+    if (top_level && op == kOpIndexData)
       checkIndexData(fields, readAt(in, pos, data_len), start, after_chunk, last_chunk);
-    if (top_level) (*top)[start] = fields;
-    if (inner != nullptr) (*inner)[start - begin] = kind;
+    if (top_level && (op == kOpFileHeader || op == kOpChunkInfo))
+      jumps->emplace_back(start, fields);
+    ops[start] = op;
     pos += data_len;
   }
-}
-
-// An 8-byte little-endian header field, or nullopt when absent or of another size.
-std::optional<std::uint64_t> field64(const std::map<std::string, std::string>& fields,
-                                     const char* name) {
-  const auto it = fields.find(name);
-  if (it == fields.end() || it->second.size() != 8) return std::nullopt;
-  const auto* p = reinterpret_cast<const unsigned char*>(it->second.data());
-  return std::uint64_t{littleEndian32(p)} | std::uint64_t{littleEndian32(p + 4)} << 32;
 }
 
 // librosbag reads the index from the file header's index_pos and each chunk from its chunk info's
 // chunk_pos: a position that is not the start of a checked record had it parse whatever bytes lie
 // there (a length of 2.3 GB it then allocated; a fuzz finding). index_pos 0 is an unindexed bag,
 // which librosbag reports itself.
-void checkJumps(const TopRecords& top, std::uint64_t file_size) {
-  const auto opOf = [](const std::map<std::string, std::string>& fields) {
-    const auto op = fields.find("op");
-    return op == fields.end() || op->second.size() != 1 ? '\0' : op->second[0];
-  };
-  for (const auto& [offset, fields] : top) {
-    const char op = opOf(fields);
-    if (op == '\x03') {
+void checkJumps(const RecordOps& top, const Jumps& jumps, std::uint64_t file_size) {
+  for (const auto& [offset, fields] : jumps) {
+    if (opOf(fields) == kOpFileHeader) {
       const auto index_pos = field64(fields, "index_pos");
       if (index_pos && *index_pos != 0 && *index_pos != file_size && top.count(*index_pos) == 0)
         fail(offset, "file header's index_pos " + std::to_string(*index_pos) +
                          " is not the start of a record");
-    }
-    if (op == '\x06') {
+    } else {
       const auto chunk_pos = field64(fields, "chunk_pos");
       const auto chunk = chunk_pos ? top.find(*chunk_pos) : top.end();
-      if (chunk == top.end() || opOf(chunk->second) != '\x05')
+      if (chunk == top.end() || chunk->second != kOpChunk)
         fail(offset, "chunk info whose chunk_pos is not the start of a chunk");
     }
   }
@@ -215,9 +224,10 @@ void checkBagRecords(const std::string& path) {
                    ": only format 2.0 is read");
   }
   in.clear();
-  TopRecords top;
-  walkRecords(in, line.size(), size, &top, nullptr);
-  checkJumps(top, size);
+  RecordOps top;
+  Jumps jumps;
+  walkRecords(in, line.size(), size, top, &jumps);
+  checkJumps(top, jumps, size);
 }
 
 }  // namespace gvio::io::bag
