@@ -46,14 +46,26 @@ std::map<std::string, std::string> headerFields(const std::vector<unsigned char>
   return fields;
 }
 
-// Reads `count` bytes at `offset` (within the file: the caller checked).
-std::vector<unsigned char> readAt(std::ifstream& in, std::uint64_t offset, std::uint64_t count) {
-  std::vector<unsigned char> bytes(count);
-  in.seekg(static_cast<std::streamoff>(offset));
-  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(count));
-  if (!in) fail(offset, "cannot be read");
-  return bytes;
-}
+// The bag read at offsets (within the file: the caller checked). A seek discards the stream's
+// buffer, so it seeks only when a read does not start where the last one ended: the walk reads
+// each record's lengths and header in order and skips most data.
+class OffsetReader {
+ public:
+  explicit OffsetReader(std::ifstream& in) : in_(in) {}
+
+  std::vector<unsigned char> readAt(std::uint64_t offset, std::uint64_t count) {
+    std::vector<unsigned char> bytes(count);
+    if (at_ != offset) in_.seekg(static_cast<std::streamoff>(offset));
+    in_.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(count));
+    if (!in_) fail(offset, "cannot be read");
+    at_ = offset + count;
+    return bytes;
+  }
+
+ private:
+  std::ifstream& in_;
+  std::optional<std::uint64_t> at_;  // where the stream stands, once known
+};
 
 using Fields = std::map<std::string, std::string>;
 // Record ops (http://wiki.ros.org/Bags/Format/2.0).
@@ -133,13 +145,13 @@ void checkIndexData(const Fields& fields, const std::vector<unsigned char>& data
 // at this level; `jumps` (at the top level only) the file header and chunk info records, whose
 // index_pos / chunk_pos librosbag seeks to.
 using Jumps = std::vector<std::pair<std::uint64_t, Fields>>;
-void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, RecordOps& ops,
+void walkRecords(OffsetReader& in, std::uint64_t begin, std::uint64_t end, RecordOps& ops,
                  Jumps* jumps) {
   const bool top_level = jumps != nullptr;
   std::uint64_t pos = begin;
   auto readLength = [&](const char* what) {
     if (end - pos < 4) fail(pos, what);
-    const std::vector<unsigned char> bytes = readAt(in, pos, 4);
+    const std::vector<unsigned char> bytes = in.readAt(pos, 4);
     pos += 4;
     return std::uint64_t{littleEndian32(bytes.data())};
   };
@@ -149,12 +161,12 @@ void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, Reco
     const std::uint64_t start = pos;
     const std::uint64_t header_len = readLength("truncated (no header length)");
     if (header_len > end - pos) fail(start, "header runs past the end of its container");
-    const Fields fields = headerFields(readAt(in, pos, header_len), start);
+    const Fields fields = headerFields(in.readAt(pos, header_len), start);
     pos += header_len;
     const std::uint64_t data_len = readLength("truncated (no data length)");
     if (data_len > end - pos) fail(start, "data runs past the end of its container");
     const char op = opOf(fields);
-    if (op == kOpConnection) headerFields(readAt(in, pos, data_len), start);
+    if (op == kOpConnection) headerFields(in.readAt(pos, data_len), start);
     if (op == kOpChunk) {
       if (!top_level) fail(start, "chunk inside a chunk");
       checkChunkHeader(fields, start, data_len);
@@ -167,7 +179,7 @@ void walkRecords(std::ifstream& in, std::uint64_t begin, std::uint64_t end, Reco
       }
     }
     if (top_level && op == kOpIndexData)
-      checkIndexData(fields, readAt(in, pos, data_len), start, after_chunk, last_chunk);
+      checkIndexData(fields, in.readAt(pos, data_len), start, after_chunk, last_chunk);
     if (top_level && (op == kOpFileHeader || op == kOpChunkInfo))
       jumps->emplace_back(start, fields);
     ops[start] = op;
@@ -226,7 +238,8 @@ void checkBagRecords(const std::string& path) {
   in.clear();
   RecordOps top;
   Jumps jumps;
-  walkRecords(in, line.size(), size, top, &jumps);
+  OffsetReader reader(in);
+  walkRecords(reader, line.size(), size, top, &jumps);
   checkJumps(top, jumps, size);
 }
 
