@@ -263,5 +263,33 @@ TEST(Rosbag, BrokenBagsAreOneLineErrorsNamingTheBag) {
                           0, "topic /cam: image 0: image encoding 'yuv422' is not supported"));
 }
 
+// ROS's deserialiser sizes a uint8[] from the length the message states before it reads the bytes:
+// an image stating 1 GB in a small bag was 1 GB allocated and zeroed (a fuzz finding). The stated
+// length is now checked against the message first, raw and PNG alike.
+TEST(Rosbag, ImageDataLongerThanItsMessageIsRefusedBeforeItIsAllocated) {
+  test::TempDir dir("rosbag");
+  for (const bool png : {false, true}) {
+    const fs::path file =
+        writeBag(dir.path() / (png ? "png.bag" : "raw.bag"), bag::Compression::kNone, [&](auto& w) {
+          bag::ImageMessage m = grayToRosImage(pattern(0), png);
+          m.t = {kT0, kT0};
+          w.write("/cam", m);
+        });
+    std::string bytes = test::readText(file);
+    // The data's length: before the PNG signature, or after the encoding, is_bigendian and step.
+    const std::string before = png ? std::string("\x89PNG") : std::string("\x05\0\0\0mono8", 9);
+    const std::size_t at = bytes.find(before);
+    ASSERT_NE(at, std::string::npos);
+    ASSERT_EQ(bytes.find(before, at + 1), std::string::npos);
+    const std::size_t length_at = png ? at - 4 : at + before.size() + 5;
+    bytes.replace(length_at, 4, std::string("\0\0\0\x3c", 4));  // 1006632960 bytes
+    test::writeText(file, bytes);
+    const std::string error = test::inputError([&] { (void)readDataset(file, std::nullopt, {}); });
+    EXPECT_TRUE(
+        test::names(error, file, 0, "image data of 1006632960 bytes stated in a message of"))
+        << error;
+  }
+}
+
 }  // namespace
 }  // namespace gvio::io

@@ -1,5 +1,6 @@
 #include "io/rosbag/bag_file.hpp"
 
+#include "io/rosbag/message_bytes.hpp"
 #include "io/rosbag/record_scan.hpp"
 
 #include <rosbag/bag.h>
@@ -9,6 +10,7 @@
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/NavSatFix.h>
 
+#include <boost/make_shared.hpp>
 #include <map>
 #include <mutex>
 
@@ -89,15 +91,33 @@ auto guarded(const std::string& what, F&& f) -> decltype(f()) {
 // The message as T: MessageInstance::instantiate gives null when the connection's md5sum is not
 // T's (a damaged record or another definition under the same type name), which is an error of
 // the bag, never a null to dereference. The md5sum itself is not quoted: it is the bag's bytes.
+[[noreturn]] void unexpectedType(const rosbag::MessageInstance& m) {
+  // The type name is the bag's text; InputError, which every BagError becomes, escapes its
+  // control bytes so that the message stays one line.
+  throw BagError("message of unexpected type " + m.getDataType() +
+                 " (its md5sum is not that of the definition gvio reads)");
+}
+
 template <typename T>
 boost::shared_ptr<T> instantiated(const rosbag::MessageInstance& m) {
   boost::shared_ptr<T> msg = m.instantiate<T>();
-  if (!msg) {
-    // The type name is the bag's text; InputError, which every BagError becomes, escapes its
-    // control bytes so that the message stays one line.
-    throw BagError("message of unexpected type " + m.getDataType() +
-                   " (its md5sum is not that of the definition gvio reads)");
-  }
+  if (!msg) unexpectedType(m);
+  return msg;
+}
+
+// An image message as T from its bytes, which `check` (message_bytes.hpp) clears first: ROS's
+// deserialiser allocates whatever length a uint8[] states before it reads the bytes.
+template <typename T>
+boost::shared_ptr<T> checkedImage(const rosbag::MessageInstance& m,
+                                  void (*check)(const std::vector<std::uint8_t>&)) {
+  if (!m.isType<T>()) unexpectedType(m);
+  std::vector<std::uint8_t> bytes(m.size());
+  ros::serialization::OStream out(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
+  m.write(out);
+  check(bytes);
+  auto msg = boost::make_shared<T>();
+  ros::serialization::IStream in(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
+  ros::serialization::deserialize(in, *msg);
   return msg;
 }
 
@@ -216,14 +236,14 @@ ImageMessage BagReader::readImage(const std::string& topic, std::size_t index) c
   return guarded("reading image " + std::to_string(index) + " of " + topic, [&] {
     ImageMessage out;
     if (m.getDataType() == kCompressedImageType) {
-      const auto msg = instantiated<sensor_msgs::CompressedImage>(m);
+      const auto msg = checkedImage<sensor_msgs::CompressedImage>(m, checkCompressedImageBytes);
       out.t = stampsOf(msg->header, m);
       out.compressed = true;
       out.format = msg->format;
       out.data = std::move(msg->data);
       return out;
     }
-    const auto msg = instantiated<sensor_msgs::Image>(m);
+    const auto msg = checkedImage<sensor_msgs::Image>(m, checkImageBytes);
     out.t = stampsOf(msg->header, m);
     out.encoding = msg->encoding;
     out.width = msg->width;
