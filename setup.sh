@@ -24,7 +24,7 @@ PACKAGES=(
   libegl-dev libgl-dev libepoxy-dev libegl-mesa0 libgl1-mesa-dri
   libgeographiclib-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
   nlohmann-json3-dev libcairo2-dev zlib1g-dev
-  librosbag-storage-dev libsensor-msgs-dev libroscpp-core-dev
+  librosbag-storage-dev libsensor-msgs-dev libroscpp-core-dev libbz2-dev
 )
 # Only the modes that build the test suite need its frameworks.
 TEST_PACKAGES=(libgtest-dev libgmock-dev libbenchmark-dev)

@@ -64,6 +64,7 @@ find_path(AMENT_INDEX_INCLUDE_DIR ament_index_cpp/get_resource.hpp PATH_SUFFIXES
           REQUIRED)
 find_path(SENSOR_MSGS_INCLUDE_DIR sensor_msgs/Image.h REQUIRED)
 find_package(Boost REQUIRED COMPONENTS filesystem)
+find_package(BZip2 REQUIRED)  # the record check decompresses bz2 chunks as librosbag does
 add_library(gvio_rosbag_deps INTERFACE)
 target_include_directories(gvio_rosbag_deps SYSTEM INTERFACE
   ${PLUGINLIB_INCLUDE_DIR} ${CLASS_LOADER_INCLUDE_DIR} ${RCUTILS_INCLUDE_DIR}

@@ -9,6 +9,9 @@
 #include <optional>
 #include <vector>
 
+#include <bzlib.h>
+#include <roslz4/lz4s.h>
+
 #include "io/rosbag/bag_file.hpp"
 
 namespace gvio::io::bag {
@@ -67,6 +70,21 @@ class OffsetReader {
   std::optional<std::uint64_t> at_;  // where the stream stands, once known
 };
 
+// A decompressed chunk, read at offsets as the file is.
+class MemoryReader {
+ public:
+  explicit MemoryReader(const std::vector<unsigned char>& bytes) : bytes_(bytes) {}
+
+  std::vector<unsigned char> readAt(std::uint64_t offset, std::uint64_t count) const {
+    if (offset > bytes_.size() || count > bytes_.size() - offset) fail(offset, "cannot be read");
+    const auto begin = bytes_.begin() + static_cast<std::ptrdiff_t>(offset);
+    return {begin, begin + static_cast<std::ptrdiff_t>(count)};
+  }
+
+ private:
+  const std::vector<unsigned char>& bytes_;
+};
+
 using Fields = std::map<std::string, std::string>;
 // Record ops (http://wiki.ros.org/Bags/Format/2.0).
 constexpr char kOpMessageData = 0x02;
@@ -97,14 +115,43 @@ std::optional<std::uint64_t> field64(const Fields& fields, const char* name) {
   return std::uint64_t{littleEndian32(p)} | std::uint64_t{littleEndian32(p + 4)} << 32;
 }
 
-void checkChunkHeader(const Fields& fields, std::uint64_t start, std::uint64_t data_len) {
+// The chunk's compression. A size librosbag could not have written is refused before anything
+// allocates it: more than 1 GiB, an uncompressed chunk of another size than its data, or an lz4
+// chunk declaring more than LZ4 can expand to (at most 255 bytes per byte: a match's length
+// grows by 255 per extension byte; https://github.com/lz4/lz4/blob/dev/doc/lz4_Block_format.md).
+std::string checkChunkHeader(const Fields& fields, std::uint64_t start, std::uint64_t data_len) {
   const auto compression = fields.find("compression");
   const auto unpacked = field32(fields, "size");
   if (compression == fields.end() || !unpacked)
     fail(start, "chunk header without compression or size");
   if (*unpacked > kMaxChunkBytes) fail(start, "chunk declares more than 1 GiB of messages");
-  if (compression->second == "none" && *unpacked != data_len)
+  const std::string& kind = compression->second;
+  if (kind != "none" && kind != "lz4" && kind != "bz2")
+    fail(start, "chunk compression is not none, lz4 or bz2");
+  if (kind == "none" && *unpacked != data_len)
     fail(start, "uncompressed chunk whose size differs from its data");
+  if (kind == "lz4" && *unpacked > 256 * data_len + 65536)
+    fail(start, "lz4 chunk declaring more data than lz4 can expand to");
+  return kind;
+}
+
+// A compressed chunk's data decompressed as librosbag decompresses it (Bz2Stream and LZ4Stream::
+// decompress: one buffer-to-buffer call into the declared size), which it must fill exactly.
+std::vector<unsigned char> decompressed(std::vector<unsigned char> packed, const std::string& kind,
+                                        std::uint32_t unpacked_size, std::uint64_t start) {
+  std::vector<unsigned char> out(std::max<std::uint32_t>(unpacked_size, 1));
+  unsigned int out_len = unpacked_size;
+  auto* dest = reinterpret_cast<char*>(out.data());
+  auto* source = reinterpret_cast<char*>(packed.data());
+  const auto source_len = static_cast<unsigned int>(packed.size());
+  const bool ok =
+      kind == "bz2" ? BZ2_bzBuffToBuffDecompress(dest, &out_len, source, source_len, 0, 0) == BZ_OK
+                    : roslz4_buffToBuffDecompress(source, source_len, dest, &out_len) == ROSLZ4_OK;
+  if (!ok) fail(start, kind + " chunk whose data does not decompress");
+  if (out_len != unpacked_size)
+    fail(start, kind + " chunk whose data decompresses to another size than it declares");
+  out.resize(unpacked_size);
+  return out;
 }
 
 // Records by their byte offset in the file: their ops.
@@ -118,13 +165,11 @@ struct ChunkRecords {
 
 // An index data record (op 0x04) follows its chunk and lists (time, offset) entries of 12 bytes;
 // librosbag reads a message record at each offset of the chunk's data as it stands (an offset
-// into the middle of a record made it read a header past its buffer: a fuzz finding). Entries
-// of a compressed chunk are not checked: librosbag decompresses that chunk itself.
+// into the middle of a record made it read a header past its buffer: a fuzz finding). The offsets
+// are into the chunk's decompressed data for a compressed chunk.
 void checkIndexData(const Fields& fields, const std::vector<unsigned char>& data,
-                    std::uint64_t start, bool after_chunk,
-                    const std::optional<ChunkRecords>& chunk) {
-  if (!after_chunk) fail(start, "index data record before any chunk");
-  if (!chunk) return;
+                    std::uint64_t start, const std::optional<ChunkRecords>& chunk) {
+  if (!chunk) fail(start, "index data record before any chunk");
   const auto count = field32(fields, "count");
   if (!count || data.size() != std::uint64_t{12} * *count)
     fail(start, "index data whose size is not 12 bytes per entry");
@@ -145,8 +190,36 @@ void checkIndexData(const Fields& fields, const std::vector<unsigned char>& data
 // at this level; `jumps` (at the top level only) the file header and chunk info records, whose
 // index_pos / chunk_pos librosbag seeks to.
 using Jumps = std::vector<std::pair<std::uint64_t, Fields>>;
-void walkRecords(OffsetReader& in, std::uint64_t begin, std::uint64_t end, RecordOps& ops,
-                 Jumps* jumps) {
+template <typename Reader>
+void walkRecords(Reader& in, std::uint64_t begin, std::uint64_t end, RecordOps& ops, Jumps* jumps);
+
+// The records of a chunk whose data is [pos, pos + data_len) of the file, walked as librosbag will
+// parse them: in the file when uncompressed, decompressed otherwise (its records go through the
+// same parser, so they get the same checks).
+template <typename Reader>
+ChunkRecords chunkRecords(Reader& in, const Fields& fields, std::uint64_t start, std::uint64_t pos,
+                          std::uint64_t data_len) {
+  const std::string kind = checkChunkHeader(fields, start, data_len);
+  ChunkRecords chunk;
+  if (kind == "none") {
+    chunk.begin = pos;
+    walkRecords(in, pos, pos + data_len, chunk.ops, nullptr);
+    return chunk;
+  }
+  const std::vector<unsigned char> data =
+      decompressed(in.readAt(pos, data_len), kind, *field32(fields, "size"), start);
+  MemoryReader memory(data);
+  try {
+    walkRecords(memory, 0, data.size(), chunk.ops, nullptr);
+  } catch (const BagError& e) {
+    throw BagError("chunk at byte " + std::to_string(start) + ", " + kind +
+                   "-decompressed: " + e.what());
+  }
+  return chunk;
+}
+
+template <typename Reader>
+void walkRecords(Reader& in, std::uint64_t begin, std::uint64_t end, RecordOps& ops, Jumps* jumps) {
   const bool top_level = jumps != nullptr;
   std::uint64_t pos = begin;
   auto readLength = [&](const char* what) {
@@ -155,7 +228,6 @@ void walkRecords(OffsetReader& in, std::uint64_t begin, std::uint64_t end, Recor
     pos += 4;
     return std::uint64_t{littleEndian32(bytes.data())};
   };
-  bool after_chunk = false;
   std::optional<ChunkRecords> last_chunk;
   while (pos < end) {
     const std::uint64_t start = pos;
@@ -169,17 +241,10 @@ void walkRecords(OffsetReader& in, std::uint64_t begin, std::uint64_t end, Recor
     if (op == kOpConnection) headerFields(in.readAt(pos, data_len), start);
     if (op == kOpChunk) {
       if (!top_level) fail(start, "chunk inside a chunk");
-      checkChunkHeader(fields, start, data_len);
-      after_chunk = true;
-      last_chunk.reset();
-      if (fields.at("compression") == "none") {
-        ChunkRecords chunk{pos, {}};
-        walkRecords(in, pos, pos + data_len, chunk.ops, nullptr);
-        last_chunk = std::move(chunk);
-      }
+      last_chunk = chunkRecords(in, fields, start, pos, data_len);
     }
     if (top_level && op == kOpIndexData)
-      checkIndexData(fields, in.readAt(pos, data_len), start, after_chunk, last_chunk);
+      checkIndexData(fields, in.readAt(pos, data_len), start, last_chunk);
     if (top_level && (op == kOpFileHeader || op == kOpChunkInfo))
       jumps->emplace_back(start, fields);
     ops[start] = op;
