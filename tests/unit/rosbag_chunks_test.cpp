@@ -7,6 +7,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <roslz4/lz4s.h>
+#include <sys/resource.h>
 
 #include <cstdint>
 #include <filesystem>
@@ -202,6 +203,17 @@ TEST(RosbagChunks, CompressedChunksOfAnotherSizeThanDeclaredAreRefused) {
                     }));
     EXPECT_TRUE(test::names(readError(garbage), garbage, 0, "does not decompress"));
   }
+  // A bz2 chunk declaring 512 MiB around 9 KiB of data: refused after decompressing what the
+  // stream holds, without allocating the declared size (this process stays far below it).
+  const fs::path declared = dir.path() / "bz2_declared.bag";
+  test::writeText(declared, withCompressedChunks(bytes, "bz2", [](Record& chunk) {
+                    chunk.set("size", le(std::uint64_t{1} << 29, 4));
+                  }));
+  EXPECT_TRUE(test::names(readError(declared), declared, 0,
+                          "decompresses to another size than it declares"));
+  rusage usage{};
+  ASSERT_EQ(getrusage(RUSAGE_SELF, &usage), 0);
+  EXPECT_LT(usage.ru_maxrss, 400 * 1024) << "peak RSS in KiB";
   // More than lz4 can expand to: refused before anything allocates the declared size.
   const fs::path huge = dir.path() / "lz4_huge.bag";
   test::writeText(huge, withCompressedChunks(bytes, "lz4", [](Record& chunk) {

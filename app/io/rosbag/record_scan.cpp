@@ -135,22 +135,54 @@ std::string checkChunkHeader(const Fields& fields, std::uint64_t start, std::uin
   return kind;
 }
 
+// A bz2 chunk's data, decompressed in steps so that memory follows what the stream holds, not
+// what the chunk header declares (up to 1 GiB; allocating that before decompressing let a damaged
+// header cost 1 GiB: a fuzz finding). As BZ2_bzBuffToBuffDecompress, which librosbag calls, it
+// ends at the end of the first stream; it must produce exactly the declared size.
+std::vector<unsigned char> bz2Decompressed(std::vector<unsigned char>& packed,
+                                           std::uint32_t unpacked_size, std::uint64_t start) {
+  bz_stream stream{};
+  if (BZ2_bzDecompressInit(&stream, 0, 0) != BZ_OK) fail(start, "bz2 decompressor not started");
+  stream.next_in = reinterpret_cast<char*>(packed.data());
+  stream.avail_in = static_cast<unsigned int>(packed.size());
+  std::vector<unsigned char> out;
+  int rc = BZ_OK;
+  while (rc == BZ_OK && out.size() <= unpacked_size) {
+    const std::size_t have = out.size();
+    const std::size_t room = std::min<std::size_t>(std::max<std::size_t>(have, 1 << 16),
+                                                   std::size_t{unpacked_size} + 1 - have);
+    out.resize(have + room);
+    stream.next_out = reinterpret_cast<char*>(out.data() + have);
+    stream.avail_out = static_cast<unsigned int>(room);
+    rc = BZ2_bzDecompress(&stream);
+    out.resize(have + room - stream.avail_out);
+    if (rc == BZ_OK && stream.avail_out > 0) rc = BZ_UNEXPECTED_EOF;  // input ended mid-stream
+  }
+  BZ2_bzDecompressEnd(&stream);
+  if (rc != BZ_STREAM_END && out.size() <= unpacked_size)
+    fail(start, "bz2 chunk whose data does not decompress");
+  return out;
+}
+
 // A compressed chunk's data decompressed as librosbag decompresses it (Bz2Stream and LZ4Stream::
 // decompress: one buffer-to-buffer call into the declared size), which it must fill exactly.
+// lz4 is decompressed into the declared size at once: checkChunkHeader bounded it by the data.
 std::vector<unsigned char> decompressed(std::vector<unsigned char> packed, const std::string& kind,
                                         std::uint32_t unpacked_size, std::uint64_t start) {
-  std::vector<unsigned char> out(std::max<std::uint32_t>(unpacked_size, 1));
-  unsigned int out_len = unpacked_size;
-  auto* dest = reinterpret_cast<char*>(out.data());
-  auto* source = reinterpret_cast<char*>(packed.data());
-  const auto source_len = static_cast<unsigned int>(packed.size());
-  const bool ok =
-      kind == "bz2" ? BZ2_bzBuffToBuffDecompress(dest, &out_len, source, source_len, 0, 0) == BZ_OK
-                    : roslz4_buffToBuffDecompress(source, source_len, dest, &out_len) == ROSLZ4_OK;
-  if (!ok) fail(start, kind + " chunk whose data does not decompress");
-  if (out_len != unpacked_size)
+  std::vector<unsigned char> out;
+  if (kind == "bz2") {
+    out = bz2Decompressed(packed, unpacked_size, start);
+  } else {
+    out.resize(std::max<std::uint32_t>(unpacked_size, 1));
+    unsigned int out_len = unpacked_size;
+    if (roslz4_buffToBuffDecompress(reinterpret_cast<char*>(packed.data()),
+                                    static_cast<unsigned int>(packed.size()),
+                                    reinterpret_cast<char*>(out.data()), &out_len) != ROSLZ4_OK)
+      fail(start, "lz4 chunk whose data does not decompress");
+    out.resize(out_len);
+  }
+  if (out.size() != unpacked_size)
     fail(start, kind + " chunk whose data decompresses to another size than it declares");
-  out.resize(unpacked_size);
   return out;
 }
 
