@@ -263,6 +263,21 @@ TEST(Rosbag, BrokenBagsAreOneLineErrorsNamingTheBag) {
                           0, "topic /cam: image 0: image encoding 'yuv422' is not supported"));
 }
 
+// librosbag reads the version line with fgets and the file header from where the stream then
+// stands, after the newline, while the version it scans ends at the first NUL: the check walks the
+// records from that same byte. Here the bytes up to the newline pass for one empty record when
+// walked from the NUL, and the length after the newline asks for 1.9 GB (a fuzz finding).
+TEST(Rosbag, TheFileHeaderIsCheckedWhereLibrosbagReadsIt) {
+  test::TempDir dir("rosbag");
+  const fs::path file = dir.path() / "nul.bag";
+  std::string bytes = std::string("#ROSBAG V2.0") + std::string(4, '\0');  // empty header at 12
+  bytes += std::string("\x10\0\0\0", 4);                                   // 16 bytes of data
+  bytes += "\n" + std::string("\x45\x3c\x2f\x70", 4) + std::string(11, ' ');
+  test::writeText(file, bytes);
+  EXPECT_TRUE(test::names(test::inputError([&] { (void)readDataset(file, std::nullopt, {}); }),
+                          file, 0, "record at byte 21: header runs past the end"));
+}
+
 // ROS's deserialiser sizes a uint8[] from the length the message states before it reads the bytes:
 // an image stating 1 GB in a small bag was 1 GB allocated and zeroed (a fuzz finding). The stated
 // length is now checked against the message first, raw and PNG alike.

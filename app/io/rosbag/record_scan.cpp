@@ -311,18 +311,20 @@ void checkBagRecords(const std::string& path) {
   if (!in) throw BagError("cannot open the file");
   const auto size = static_cast<std::uint64_t>(in.tellg());
   // The version line as librosbag reads it, so that every file it takes for version 2.0 is
-  // checked from where it reads the file header: Bag::readVersion scans the line with the format
-  // below, and ChunkedFile::getline reads it with fgets into 1024 bytes and goes on from the end
-  // of the C string it got: after the newline, after 1023 bytes without one, or at a NUL byte.
-  // "#ROSBAG V2.0" followed by other bytes, or by a NUL and no newline at all, is 2.0 to it too
-  // (two fuzz findings: its header parser read past its buffer, and allocated 4 GB).
+  // checked from where it reads the file header. ChunkedFile::getline reads the line with fgets
+  // into 1024 bytes: the stream then stands after the newline, or after 1023 bytes without one,
+  // and Bag::readFileHeaderRecord reads on from there (no seek). Bag::readVersion scans the C
+  // string it got with the format below, which ends at the first NUL byte. So "#ROSBAG V2.0"
+  // followed by other bytes, or by a NUL, is 2.0 to it, read from after the newline (three fuzz
+  // findings: its header parser read past its buffer, then allocated 4 GB and 1.9 GB; the last
+  // of these was read from where the C string ended, wrongly).
   constexpr std::uint64_t kFgetsBytes = 1023;
-  std::string line(std::min(size, kFgetsBytes), '\0');
+  std::string head(std::min(size, kFgetsBytes), '\0');
   in.seekg(0);
-  in.read(line.data(), static_cast<std::streamsize>(line.size()));
-  if (const std::size_t newline = line.find('\n'); newline != std::string::npos)
-    line.resize(newline + 1);
-  if (const std::size_t nul = line.find('\0'); nul != std::string::npos) line.resize(nul);
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  const std::size_t newline = head.find('\n');
+  const std::uint64_t header_pos = newline == std::string::npos ? head.size() : newline + 1;
+  const std::string line = head.substr(0, std::min<std::size_t>(header_pos, head.find('\0')));
   std::array<char, 100> type{};
   int major = -1, minor = -1;
   if (std::sscanf(line.c_str(), "#ROS%99s V%d.%d", type.data(), &major, &minor) != 3) return;
@@ -336,7 +338,7 @@ void checkBagRecords(const std::string& path) {
   RecordOps top;
   Jumps jumps;
   OffsetReader reader(in);
-  walkRecords(reader, line.size(), size, top, &jumps);
+  walkRecords(reader, header_pos, size, top, &jumps);
   checkJumps(top, jumps, size);
 }
 
