@@ -136,8 +136,8 @@ std::string checkChunkHeader(const Fields& fields, std::uint64_t start, std::uin
 }
 
 // A bz2 chunk's data, decompressed in steps so that memory follows what the stream holds, not
-// what the chunk header declares (up to 1 GiB; allocating that before decompressing let a damaged
-// header cost 1 GiB: a fuzz finding). As BZ2_bzBuffToBuffDecompress, which librosbag calls, it
+// what the chunk header declares (up to 1 GiB: allocated first, a damaged size field would cost
+// that much for a few bytes of data). As BZ2_bzBuffToBuffDecompress, which librosbag calls, it
 // ends at the end of the first stream; it must produce exactly the declared size.
 std::vector<unsigned char> bz2Decompressed(std::vector<unsigned char>& packed,
                                            std::uint32_t unpacked_size, std::uint64_t start) {
@@ -189,7 +189,8 @@ std::vector<unsigned char> decompressed(std::vector<unsigned char> packed, const
 // Records by their byte offset in the file: their ops.
 using RecordOps = std::map<std::uint64_t, char>;
 
-// The records of the last chunk, when it is uncompressed (its data starts at `begin`).
+// The records of the last chunk: by their offset in the file from `begin` (its data) when it is
+// uncompressed, in its decompressed data (`begin` 0) otherwise.
 struct ChunkRecords {
   std::uint64_t begin = 0;
   RecordOps ops;
