@@ -167,8 +167,10 @@ void readGnss(const BagReader& reader, const std::string& topic, const ReaderCon
   std::size_t no_fix = 0;
   for (const auto& [t_ns, i] : ordered(stampsOf(messages), use)) {
     const bag::NavSatFixMessage& m = messages[i];
+    // No fix (status -1, or NaN as drivers write for none), or a position off the globe (a
+    // damaged message; a fuzz finding): skipped and counted, as the EuRoC GNSS reader does.
     if (m.status < 0 || !std::isfinite(m.lat_deg) || !std::isfinite(m.lon_deg) ||
-        !std::isfinite(m.alt_m)) {
+        !std::isfinite(m.alt_m) || std::abs(m.lat_deg) > 90.0 || std::abs(m.lon_deg) > 180.0) {
       ++no_fix;
       continue;
     }
@@ -193,8 +195,10 @@ void readGnss(const BagReader& reader, const std::string& topic, const ReaderCon
   }
   use.used = ds.gnss.size();
   if (no_fix > 0) {
-    ds.warnings.push_back(fmt::format("{}: topic {}: {} messages without a fix skipped",
-                                      ds.root.string(), topic, no_fix));
+    ds.warnings.push_back(
+        fmt::format("{}: topic {}: {} messages without a fix skipped (status -1, or a position "
+                    "not finite or out of range)",
+                    ds.root.string(), topic, no_fix));
   }
   if (!ds.gnss.empty()) ds.gnss_source = ds.root.string() + ":" + topic;
 }

@@ -205,6 +205,12 @@ TEST(Rosbag, NavSatFixStatusAndCovarianceToQualityAndSigmas) {
     w.write("/fix", fix(kT0 + 3'000'000'000, 2, 0.02, 3));  // GBAS, centimetre: RTK fixed
     w.write("/fix", fix(kT0 + 4'000'000'000, 2, 0.4, 3));   // GBAS, decimetre: RTK float
     w.write("/fix", fix(kT0 + 5'000'000'000, 1, 0.8, 1));   // SBAS
+    auto off_globe = fix(kT0 + 6'000'000'000, 0, 2.5, 2);   // longitude 200 deg: skipped
+    off_globe.lon_deg = 200.0;
+    w.write("/fix", off_globe);
+    auto below_pole = fix(kT0 + 7'000'000'000, 0, 2.5, 2);  // latitude -91 deg: skipped
+    below_pole.lat_deg = -91.0;
+    w.write("/fix", below_pole);
   });
   ReaderConfig config;
   const Dataset ds = readDataset(file, std::nullopt, config);
@@ -220,7 +226,7 @@ TEST(Rosbag, NavSatFixStatusAndCovarianceToQualityAndSigmas) {
   EXPECT_EQ(ds.gnss[4].quality, 2);
   EXPECT_DOUBLE_EQ(ds.gnss[0].h_ellipsoid_m, 116.0);
   EXPECT_EQ(ds.gnss_source, file.string() + ":/fix");
-  EXPECT_THAT(ds.warnings.front(), HasSubstr("1 messages without a fix skipped"));
+  EXPECT_THAT(ds.warnings.front(), HasSubstr("3 messages without a fix skipped"));
 }
 
 TEST(Rosbag, BrokenBagsAreOneLineErrorsNamingTheBag) {
