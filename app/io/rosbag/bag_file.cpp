@@ -88,16 +88,17 @@ auto guarded(const std::string& what, F&& f) -> decltype(f()) {
   }
 }
 
-// The message as T: MessageInstance::instantiate gives null when the connection's md5sum is not
-// T's (a damaged record or another definition under the same type name), which is an error of
-// the bag, never a null to dereference. The md5sum itself is not quoted: it is the bag's bytes.
+// A message whose connection's md5sum is not that of the type gvio reads it as (a damaged record
+// or another definition under the same type name). The md5sum itself is not quoted: it is the
+// bag's bytes. The type name is the bag's text too; InputError, which every BagError becomes,
+// escapes its control bytes so that the message stays one line.
 [[noreturn]] void unexpectedType(const rosbag::MessageInstance& m) {
-  // The type name is the bag's text; InputError, which every BagError becomes, escapes its
-  // control bytes so that the message stays one line.
   throw BagError("message of unexpected type " + m.getDataType() +
                  " (its md5sum is not that of the definition gvio reads)");
 }
 
+// The message as T: MessageInstance::instantiate gives null for another md5sum, which is an error
+// of the bag, never a null to dereference.
 template <typename T>
 boost::shared_ptr<T> instantiated(const rosbag::MessageInstance& m) {
   boost::shared_ptr<T> msg = m.instantiate<T>();

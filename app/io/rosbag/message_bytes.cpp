@@ -3,6 +3,7 @@
 #include <string>
 
 #include "io/rosbag/bag_file.hpp"
+#include "io/rosbag/little_endian.hpp"
 
 namespace gvio::io::bag {
 
@@ -24,8 +25,7 @@ class FieldCursor {
   std::uint32_t u32(const char* field) {
     const std::size_t at = pos_;
     skip(4, field);
-    return std::uint32_t{bytes_[at]} | std::uint32_t{bytes_[at + 1]} << 8 |
-           std::uint32_t{bytes_[at + 2]} << 16 | std::uint32_t{bytes_[at + 3]} << 24;
+    return littleEndian32(&bytes_[at]);
   }
 
   // A string or uint8[]: its u32 length, then that many bytes.

@@ -13,17 +13,13 @@
 #include <roslz4/lz4s.h>
 
 #include "io/rosbag/bag_file.hpp"
+#include "io/rosbag/little_endian.hpp"
 
 namespace gvio::io::bag {
 
 namespace {
 
 constexpr std::uint64_t kMaxChunkBytes = std::uint64_t{1} << 30;
-
-std::uint32_t littleEndian32(const unsigned char* p) {
-  return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 |
-         std::uint32_t{p[3]} << 24;
-}
 
 [[noreturn]] void fail(std::uint64_t offset, const std::string& what) {
   throw BagError("record at byte " + std::to_string(offset) + ": " + what);
@@ -115,11 +111,17 @@ std::optional<std::uint64_t> field64(const Fields& fields, const char* name) {
   return std::uint64_t{littleEndian32(p)} | std::uint64_t{littleEndian32(p + 4)} << 32;
 }
 
-// The chunk's compression. A size librosbag could not have written is refused before anything
+// A chunk header's compression and declared (uncompressed) size.
+struct ChunkHeader {
+  std::string compression;
+  std::uint32_t size = 0;
+};
+
+// The chunk's header. A size librosbag could not have written is refused before anything
 // allocates it: more than 1 GiB, an uncompressed chunk of another size than its data, or an lz4
 // chunk declaring more than LZ4 can expand to (at most 255 bytes per byte: a match's length
 // grows by 255 per extension byte; https://github.com/lz4/lz4/blob/dev/doc/lz4_Block_format.md).
-std::string checkChunkHeader(const Fields& fields, std::uint64_t start, std::uint64_t data_len) {
+ChunkHeader checkChunkHeader(const Fields& fields, std::uint64_t start, std::uint64_t data_len) {
   const auto compression = fields.find("compression");
   const auto unpacked = field32(fields, "size");
   if (compression == fields.end() || !unpacked)
@@ -132,7 +134,7 @@ std::string checkChunkHeader(const Fields& fields, std::uint64_t start, std::uin
     fail(start, "uncompressed chunk whose size differs from its data");
   if (kind == "lz4" && *unpacked > 256 * data_len + 65536)
     fail(start, "lz4 chunk declaring more data than lz4 can expand to");
-  return kind;
+  return {kind, *unpacked};
 }
 
 // A bz2 chunk's data, decompressed in steps so that memory follows what the stream holds, not
@@ -217,7 +219,7 @@ void checkIndexData(const Fields& fields, const std::vector<unsigned char>& data
 
 // The records in [begin, end) of the file, which they must fill exactly: every header's fields
 // well formed, and every connection record's data (its connection header, the same format) too.
-// At the top level the records inside each uncompressed chunk are walked as well. librosbag
+// At the top level the records inside each chunk are walked as well (chunkRecords). librosbag
 // parses all of these with ros::Header::parse, which trusts each field's length: a field longer
 // than its header made it read past its buffer (a fuzz finding). `ops` gets every record walked
 // at this level; `jumps` (at the top level only) the file header and chunk info records, whose
@@ -232,7 +234,8 @@ void walkRecords(Reader& in, std::uint64_t begin, std::uint64_t end, RecordOps& 
 template <typename Reader>
 ChunkRecords chunkRecords(Reader& in, const Fields& fields, std::uint64_t start, std::uint64_t pos,
                           std::uint64_t data_len) {
-  const std::string kind = checkChunkHeader(fields, start, data_len);
+  const ChunkHeader header = checkChunkHeader(fields, start, data_len);
+  const std::string& kind = header.compression;
   ChunkRecords chunk;
   if (kind == "none") {
     chunk.begin = pos;
@@ -240,7 +243,7 @@ ChunkRecords chunkRecords(Reader& in, const Fields& fields, std::uint64_t start,
     return chunk;
   }
   const std::vector<unsigned char> data =
-      decompressed(in.readAt(pos, data_len), kind, *field32(fields, "size"), start);
+      decompressed(in.readAt(pos, data_len), kind, header.size, start);
   MemoryReader memory(data);
   try {
     walkRecords(memory, 0, data.size(), chunk.ops, nullptr);
