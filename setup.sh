@@ -65,12 +65,13 @@ build() {
 # The instrumented builds with clang: build_instrumented DIR SANITIZERS FUZZ [ninja targets...].
 # With FUZZ=ON every target also carries libFuzzer's coverage, so that the fuzz targets and the
 # ASan+UBSan suite share one build (build-san); ThreadSanitizer has a build of its own
-# (build-tsan). -O1 keeps asserts on and the drives bearable.
+# (build-tsan). -O1 keeps asserts on and the drives bearable; line tables alone are what the
+# sanitizers' stack traces need (file:line) and build faster than -g (12m47s clean on 2 cores).
 build_instrumented() {
   local dir="$1" sanitizers="$2" fuzz="$3"
   shift 3
   CC=clang-14 CXX=clang++-14 cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -DGVIO_SANITIZE="$sanitizers" -DGVIO_FUZZ="$fuzz" \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DGVIO_SANITIZE="$sanitizers" -DGVIO_FUZZ="$fuzz" \
     -DGVIO_WERROR=OFF -DGVIO_BUILD_TESTS=ON >/dev/null
   local targets=()
   for t in "$@"; do targets+=(--target "$t"); done
@@ -86,10 +87,12 @@ export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1:dete
 export LSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 
-# The drives too slow to repeat under ASan on every change (./setup.sh sanitize quick skips them).
-# The fault cases that run the whole 10 s drive (1.5-3.5 min each under ASan) are among them; the
-# quick run keeps the fault cases refused at the input.
-QUICK_SANITIZE_EXCLUDE='^(CliGnssFile|CliKalibr|CliLoops|CliLoopsNoRevisit|CliLoopsRepetitive|CliMap|CliMapLoop|CliRosbag|CliRunDeterminism|CliRunEndToEnd|CliRunGnss|CliRunThreads|CliTimeOffset|VioDrive|SimEndToEnd|SimWorldRenderTest|SimWorldStyles|SimWorldStylesRender|MappingSim)\.|^FeatureTrackerTest\.TracksPersist|^FaultInputs\.(.*Skips|FiveSecond)|^FaultGnss\.(Kilometre|Forward)|^FaultOutput\.(FileSize|Sig)'
+# The drives too slow to repeat under ASan on every change (./setup.sh sanitize quick and CI skip
+# them): every test that takes more than 30 s under ASan on this 2-core machine class. The fault
+# cases that run the whole 10 s drive (1.5-3.5 min each under ASan) are among them; the quick run
+# keeps the fault cases refused at the input. With them the ASan suite takes 20 min at -j2, without
+# them about 4 min.
+QUICK_SANITIZE_EXCLUDE='^(CliGnssFile|CliKalibr|CliLoops|CliLoopsNoRevisit|CliLoopsRepetitive|CliMap|CliMapLoop|CliMerge|CliMergeAlign|CliRenderCamera|CliRosbag|CliRunDeterminism|CliRunEndToEnd|CliRunGnss|CliRunThreads|CliTimeOffset|VioDrive|SimEndToEnd|SimWorldRenderTest|SimWorldStyles|SimWorldStylesRender|MappingSim)\.|^FeatureTrackerTest\.TracksPersist|^FaultInputs\.(.*Skips|FiveSecond)|^FaultGnss\.(Kilometre|Forward)|^FaultOutput\.(FileSize|Sig)|^CliFleet\.(Runs|Retries)|^CliConsistencyImages\.(TheTrue|PosesMoved|TheVio)|^slurm_fleet$'
 
 # What runs on threads, for ThreadSanitizer: the ordered worker and prefetcher, the VIO tracking
 # the next frame during the solve, and whole threaded runs of gvio (decoding ahead, keyframe work,
