@@ -4,10 +4,11 @@
 #   ./setup.sh demo    the main job on the embedded demo input (the default)
 #   ./setup.sh test    every test (ctest); this is what CI runs
 #   ./setup.sh build   install + build only
-#   ./setup.sh sanitize [quick|thread]
+#   ./setup.sh sanitize [quick|thread|thread-quick]
 #                      the test suite built with AddressSanitizer + UndefinedBehaviorSanitizer
 #                      (clang, in build-san; quick: without the slow drives), then the threaded
-#                      tests with ThreadSanitizer (build-tsan; thread: only those);
+#                      tests with ThreadSanitizer (build-tsan; thread: only those; thread-quick:
+#                      only the ordered worker's);
 #                      SANITIZE_EXCLUDE (a ctest -E regex) skips tests of the ASan run
 #   ./setup.sh fuzz [SECONDS [TARGET...]]
 #                      every libFuzzer target (tests/fuzz) for SECONDS each (default 60)
@@ -101,9 +102,15 @@ TSAN_TESTS='(^|/)(OrderedWork.*|VioDrive\.TrackingAheadGivesTheSameResultsThroug
 export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/tests/sanitizers/tsan.supp"
 
 # ./setup.sh sanitize: the whole suite under ASan + UBSan, then the threaded tests under TSan;
-# quick: ASan + UBSan without the slow drives; thread: the TSan part alone.
+# quick: ASan + UBSan without the slow drives; thread: the TSan part alone; thread-quick: TSan over
+# the ordered worker and prefetcher only (their own small binary: what CI has time for).
 sanitize() {
   local exclude="${SANITIZE_EXCLUDE:-}"
+  if [ "${1:-}" = thread-quick ]; then
+    build_instrumented build-tsan thread OFF gvio_ordered_work_tests
+    build-tsan/tests/gvio_ordered_work_tests
+    return
+  fi
   if [ "${1:-}" != thread ]; then
     [ "${1:-}" = quick ] && exclude="$QUICK_SANITIZE_EXCLUDE"
     build_instrumented build-san address,undefined ON
@@ -157,7 +164,7 @@ case "$mode" in
       "in out/demo/run, images in out/demo/run/render, the image check in out/demo/run/consistency_images"
     ;;
   *)
-    echo "usage: ./setup.sh [demo|test|build|sanitize [quick|thread]|fuzz [SECONDS [TARGET...]]]" >&2
+    echo "usage: ./setup.sh [demo|test|build|sanitize [quick|thread|thread-quick]|fuzz [SECONDS [TARGET...]]]" >&2
     exit 2
     ;;
 esac
