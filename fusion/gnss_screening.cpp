@@ -33,7 +33,7 @@ ScreeningResult screenFixes(const std::vector<GnssFix>& fixes, std::int64_t driv
       ++c.non_finite;
     } else if (!(f.sigma_h_m > 0.0) || !(f.sigma_v_m > 0.0)) {
       ++c.bad_sigma;
-    } else if (std::abs(f.lat_deg) > 90.0 || std::abs(f.lon_deg) > 180.0) {
+    } else if (latLonOutOfRange(f.lat_deg, f.lon_deg)) {
       ++c.out_of_range;
     } else if (f.t_ns < drive_begin_ns - margin_ns || f.t_ns > drive_end_ns + margin_ns) {
       ++c.outside_drive;

@@ -2,6 +2,7 @@
 // Screening of GNSS fixes before fusion (issue 7, bad input): fixes with NaN, zero or negative
 // sigma, latitude/longitude out of range, or stamps far outside the drive are skipped and counted,
 // never fatal and never used.
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -9,6 +10,12 @@
 #include "odometry/measurements.hpp"
 
 namespace gvio::fusion {
+
+// A latitude/longitude no place on Earth has: |lat| > 90 deg or |lon| > 180 deg. NaN is not out
+// of range here (every caller checks finiteness on its own, and counts it apart).
+[[nodiscard]] inline bool latLonOutOfRange(double lat_deg, double lon_deg) {
+  return std::abs(lat_deg) > 90.0 || std::abs(lon_deg) > 180.0;
+}
 
 struct ScreeningCounts {
   int kept = 0;

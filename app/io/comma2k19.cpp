@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "fusion/geodesy.hpp"
+#include "fusion/gnss_screening.hpp"
 #include "io/input_error.hpp"
 #include "io/text.hpp"
 
@@ -96,7 +97,7 @@ Dataset readComma2k19(const fs::path& dir, const ReaderConfig& config) {
       fixes,
       {"t_boot_s", "lat_deg", "lon_deg", "alt_m", "speed_mps", "bearing_deg", "utc_timestamp"},
       [&](const LineReader& at, std::int64_t t_ns, const std::vector<double>& v) {
-        if (std::abs(v[0]) > 90.0 || std::abs(v[1]) > 180.0) {
+        if (fusion::latLonOutOfRange(v[0], v[1])) {
           at.fail("latitude/longitude out of range");
         }
         if (v[3] < 0.0) at.fail("negative speed_mps");

@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 
+#include "fusion/gnss_screening.hpp"
 #include "io/input_error.hpp"
 #include "io/rotation_check.hpp"
 #include "io/sensor_yaml.hpp"
@@ -125,7 +126,7 @@ std::vector<GnssFix> readGnssCsv(const fs::path& file, std::vector<std::string>&
     fix.h_ellipsoid_m = parseFinite(f[3], at, "height");
     fix.sigma_h_m = parseFinite(f[4], at, "sigma_h");
     fix.sigma_v_m = parseFinite(f[5], at, "sigma_v");
-    if (std::abs(fix.lat_deg) > 90.0 || std::abs(fix.lon_deg) > 180.0 || fix.sigma_h_m <= 0.0 ||
+    if (fusion::latLonOutOfRange(fix.lat_deg, fix.lon_deg) || fix.sigma_h_m <= 0.0 ||
         fix.sigma_v_m <= 0.0) {
       if (skipped++ == 0) first_skipped_line = at.lineNumber();
       return;

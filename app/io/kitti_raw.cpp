@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "fusion/gnss_screening.hpp"
 #include "io/dataset.hpp"
 #include "io/input_error.hpp"
 #include "io/kitti_calib.hpp"
@@ -121,7 +122,7 @@ void addOxtsGnss(const std::vector<double>& rec, std::int64_t t_ns, const fs::pa
                  std::size_t& skipped, Dataset& ds) {
   // pos_accuracy is the OXTS unit's own north/east position accuracy; it is the only sigma
   // KITTI records, so it serves for the vertical too.
-  if (rec[kPosAccuracy] <= 0.0 || std::abs(rec[kLat]) > 90.0 || std::abs(rec[kLon]) > 180.0) {
+  if (rec[kPosAccuracy] <= 0.0 || fusion::latLonOutOfRange(rec[kLat], rec[kLon])) {
     if (skipped++ == 0) spdlog::debug("{}: unusable GNSS fields, fix skipped", file.string());
     return;
   }

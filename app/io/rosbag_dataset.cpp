@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "fusion/gnss_screening.hpp"
 #include "io/input_error.hpp"
 #include "io/ros_image.hpp"
 #include "io/rosbag/bag_file.hpp"
@@ -170,7 +171,7 @@ void readGnss(const BagReader& reader, const std::string& topic, const ReaderCon
     // No fix (status -1, or NaN as drivers write for none), or a position off the globe (a
     // damaged message; a fuzz finding): skipped and counted, as the EuRoC GNSS reader does.
     if (m.status < 0 || !std::isfinite(m.lat_deg) || !std::isfinite(m.lon_deg) ||
-        !std::isfinite(m.alt_m) || std::abs(m.lat_deg) > 90.0 || std::abs(m.lon_deg) > 180.0) {
+        !std::isfinite(m.alt_m) || fusion::latLonOutOfRange(m.lat_deg, m.lon_deg)) {
       ++no_fix;
       continue;
     }
