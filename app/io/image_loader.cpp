@@ -39,6 +39,19 @@ std::string chunkName(const unsigned char* p) {
   return name;
 }
 
+// libpng refuses a side over its default user limit of 1,000,000 px (png_set_user_limits) or a
+// zero side, printing "libpng warning/error" lines first: such an IHDR (the first chunk, PNG
+// specification section 5.6) is a defect here. "" when the header is missing (left to the walk).
+std::string pngSizeDefect(const std::vector<unsigned char>& bytes, std::size_t pos) {
+  constexpr std::uint32_t kMaxSidePx = 1'000'000;
+  if (bytes.size() - pos < 8 + 8 || chunkName(&bytes[pos + 4]) != "IHDR") return {};
+  const std::uint32_t width = bigEndian32(&bytes[pos + 8]);
+  const std::uint32_t height = bigEndian32(&bytes[pos + 12]);
+  if (width == 0 || height == 0 || width > kMaxSidePx || height > kMaxSidePx)
+    return fmt::format("PNG of {}x{} px (each side must be 1 to {})", width, height, kMaxSidePx);
+  return {};
+}
+
 // libpng prints "libpng error: ..." on stderr before OpenCV reports a failed decode, so a damaged
 // PNG would add a stray line to the CLI's one-line error. Walks the chunk structure first
 // (lengths, CRCs, IEND) and returns what is wrong, or "" for a sound file or a non-PNG.
@@ -48,6 +61,7 @@ std::string pngDefect(const std::vector<unsigned char>& bytes) {
     return {};  // not a PNG: left to the other decoders
   }
   std::size_t pos = kPngSignature.size();
+  if (const std::string d = pngSizeDefect(bytes, pos); !d.empty()) return d;
   while (true) {
     if (bytes.size() - pos < 12) return "truncated PNG (no IEND chunk)";
     const std::uint32_t length = bigEndian32(&bytes[pos]);
@@ -92,7 +106,16 @@ cv::Mat decodeGrayPngOrJpeg(const std::vector<unsigned char>& bytes, std::string
         bytes.empty() ? "empty" : "not a PNG or JPEG (its first bytes are neither's signature)";
   }
   if (!defect.empty()) return {};
-  cv::Mat image = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+  cv::Mat image;
+  try {
+    image = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+  } catch (const cv::Exception& e) {
+    // imdecode checks the header's size against CV_IO_MAX_IMAGE_PIXELS (2^30) and width/height
+    // against 2^20 with CV_Assert outside its decoders' try (OpenCV 4.6 loadsave.cpp): a JPEG
+    // declaring 60000x60000 threw (found by fuzzing ros_image in CI).
+    defect = "the decoder refused it (" + e.err + ")";
+    return {};
+  }
   if (image.empty()) defect = "corrupt PNG/JPEG data";
   return image;
 }

@@ -5,7 +5,8 @@
 # Prints one line per target: executions, coverage (libFuzzer's "cov", edges) and the verdict;
 # writes the same table to BUILD/fuzz/summary.txt.
 # FUZZ_RUNS=N also stops a target after N executions (the 10^6 benchmark: FUZZ_RUNS=1000000
-# with a generous SECONDS).
+# with a generous SECONDS). FUZZ_SEED=N fixes libFuzzer's random seed (CI: a failure there is
+# replayed by the same command); without it every run explores from a fresh seed.
 #   usage: tests/fuzz/run_fuzzers.sh BUILD_DIR SECONDS [TARGET...]
 set -uo pipefail
 build="$1"
@@ -29,7 +30,7 @@ for t in "${targets[@]}"; do
   mkdir -p "$work" "$artifacts"
   # Leaks are checked (ASan's LeakSanitizer); readers on 2 GB inputs are out of scope (-rss_limit).
   GVIO_FUZZ_TARGET="$t" "$fuzzer" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
-    -max_len=65536 ${FUZZ_RUNS:+-runs="$FUZZ_RUNS"} -print_final_stats=1 -artifact_prefix="$artifacts" "$work" "$here/corpus/$t" \
+    -max_len=65536 ${FUZZ_RUNS:+-runs="$FUZZ_RUNS"} ${FUZZ_SEED:+-seed="$FUZZ_SEED"} -print_final_stats=1 -artifact_prefix="$artifacts" "$work" "$here/corpus/$t" \
     >"$log" 2>&1
   rc=$?
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)

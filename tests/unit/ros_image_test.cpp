@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -34,6 +36,8 @@ bag::ImageMessage raw(const cv::Mat& m, const std::string& encoding, int pad_byt
   for (int r = 0; r < m.rows; ++r) std::memcpy(&out.data[r * out.step], m.ptr(r), row);
   return out;
 }
+
+constexpr std::array<std::uint8_t, 2> kSof0 = {0xFF, 0xC0};  // baseline JPEG frame header
 
 std::string error(const bag::ImageMessage& m) {
   try {
@@ -130,6 +134,25 @@ TEST(RosImage, RefusalsSayWhatIsWrong) {
   bag::ImageMessage empty = raw(g, "mono8");
   empty.width = 0;
   EXPECT_THAT(error(empty), HasSubstr("image of 0x6 pixels"));
+}
+
+// A header may declare any size: OpenCV asserts (throws) on more than 2^30 pixels and libpng
+// prints lines of its own over 10^6 px a side. Both are refused as one-line defects.
+TEST(RosImage, OversizedHeadersAreRefusedNotThrown) {
+  const cv::Mat g = gradient();
+  bag::ImageMessage jpeg;
+  jpeg.compressed = true;
+  jpeg.format = "mono8; jpeg compressed mono8";
+  cv::imencode(".jpg", g, jpeg.data);
+  const auto sof = std::search(jpeg.data.begin(), jpeg.data.end(), kSof0.begin(), kSof0.end());
+  ASSERT_NE(sof, jpeg.data.end());
+  const std::array<std::uint8_t, 4> huge = {0xEA, 0x60, 0xEA, 0x60};  // 60000 x 60000
+  std::copy(huge.begin(), huge.end(), sof + 5);                       // after length, precision
+  EXPECT_THAT(error(jpeg), HasSubstr("cannot be decoded: the decoder refused it ("));
+  bag::ImageMessage png = grayToRosImage(g, true);
+  const std::array<std::uint8_t, 4> wide = {0x00, 0x1E, 0x84, 0x80};  // 2,000,000
+  std::copy(wide.begin(), wide.end(), png.data.begin() + 16);         // IHDR width
+  EXPECT_THAT(error(png), HasSubstr("PNG of 2000000x6 px (each side must be 1 to 1000000)"));
 }
 
 }  // namespace
