@@ -40,6 +40,12 @@ cv::Mat rawToGray(const bag::ImageMessage& m) {
     throw InvalidInput(fmt::format("{}x{} {} image with step {} does not fit its {} bytes of data",
                                    m.width, m.height, m.encoding, m.step, m.data.size()));
   }
+  // OpenCV (and so cv_bridge) needs a row step that is a whole number of channel values: an odd
+  // step of a 16-bit image threw from cv::Mat (found by fuzzing ros_image).
+  if (m.step % CV_ELEM_SIZE1(layout.type) != 0) {
+    throw InvalidInput(fmt::format("{} image with step {}: not a multiple of its {}-byte values",
+                                   m.encoding, m.step, CV_ELEM_SIZE1(layout.type)));
+  }
   // A view of the message's rows (step may pad them); converted copies below own their pixels.
   const cv::Mat view(static_cast<int>(m.height), static_cast<int>(m.width), layout.type,
                      const_cast<std::uint8_t*>(m.data.data()), m.step);

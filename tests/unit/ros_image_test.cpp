@@ -131,6 +131,13 @@ TEST(RosImage, RefusalsSayWhatIsWrong) {
   bag::ImageMessage bmp = grayToRosImage(g, true);
   cv::imencode(".bmp", g, bmp.data);  // BMP decodes in OpenCV, but is no ROS compressed format
   EXPECT_THAT(error(bmp), HasSubstr("not a PNG or JPEG"));
+  bag::ImageMessage odd_step = raw(g, "mono8");
+  odd_step.encoding = "mono16";
+  odd_step.width = 2;
+  odd_step.height = 4;
+  odd_step.step = 11;
+  EXPECT_THAT(error(odd_step),
+              HasSubstr("mono16 image with step 11: not a multiple of its 2-byte"));
   bag::ImageMessage empty = raw(g, "mono8");
   empty.width = 0;
   EXPECT_THAT(error(empty), HasSubstr("image of 0x6 pixels"));
