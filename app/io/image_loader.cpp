@@ -113,7 +113,7 @@ cv::Mat decodeGrayPngOrJpeg(const std::vector<unsigned char>& bytes, std::string
     // imdecode checks the header's size against CV_IO_MAX_IMAGE_PIXELS (2^30) and width/height
     // against 2^20 with CV_Assert outside its decoders' try (OpenCV 4.6 loadsave.cpp): a JPEG
     // declaring 60000x60000 threw (found by fuzzing ros_image in CI).
-    defect = "the decoder refused it (" + e.err + ")";
+    defect = "the decoder refused it (OpenCV's check failed: " + e.err + ")";
     return {};
   }
   if (image.empty()) defect = "corrupt PNG/JPEG data";
