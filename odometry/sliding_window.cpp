@@ -257,7 +257,7 @@ SolveStats SlidingWindow::solve(bool use_imu) {
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_SCHUR;
   options.trust_region_strategy_type = ceres::DOGLEG;
-  options.max_num_iterations = config_.max_iterations;
+  options.max_num_iterations = config_.solverIterations();
   // The inverse-depth lower bound makes the problem constrained, and Ceres then runs an Armijo
   // line search along every trust-region step, with a full Jacobian evaluation each time (about
   // 15 % of the solve). Its own source calls that search "not terribly effective" (ceres-solver

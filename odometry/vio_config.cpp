@@ -42,6 +42,11 @@ VioMode parseVioMode(const std::string& name) {
                      "')");
 }
 
+int EstimatorConfig::solverIterations() const {
+  if (max_iterations > 0) return max_iterations;
+  return mode == VioMode::kStereoImu ? 2 : 4;
+}
+
 void EstimatorConfig::validate() const {
   tracker.validate();
   if (usesImu(mode)) imu_noise.validate();
@@ -51,7 +56,8 @@ void EstimatorConfig::validate() const {
   require(keyframe_min_tracked >= 1, "keyframe_min_tracked", ">= 1");
   require(positive(pixel_sigma_px), "pixel_sigma_px", "> 0");
   require(positive(huber_sigmas), "huber_sigmas", "> 0");
-  require(max_iterations >= 1 && max_iterations <= 100, "max_iterations", "in [1, 100]");
+  require(max_iterations >= 0 && max_iterations <= 100, "max_iterations",
+          "auto (0) or in [1, 100]");
   require(positive(min_depth_m), "min_depth_m", "> 0");
   require(positive(max_depth_m) && max_depth_m > min_depth_m, "max_depth_m", "> min_depth_m");
   require(positive(max_reprojection_px), "max_reprojection_px", "> 0");

@@ -57,6 +57,24 @@ ConfigKey integer(std::string name, int& field) {
       [&field] { return std::to_string(field); }};
 }
 
+// "auto" (stored as 0: the library picks by mode) or an integer >= 1.
+ConfigKey integerOrAuto(std::string name, int& field) {
+  ConfigKey plain = integer(name, field);
+  return {name,
+          [name, &field, set = plain.set](std::string_view v) {
+            if (v == "auto") {
+              field = 0;
+              return;
+            }
+            set(v);
+            if (field < 1) {
+              throw InvalidInput(
+                  fmt::format("bad value '{}' for {}: expected auto or an integer >= 1", v, name));
+            }
+          },
+          [&field] { return field == 0 ? std::string("auto") : std::to_string(field); }};
+}
+
 // Vectors are written "x,y,z" (a YAML sequence flattens to that form).
 ConfigKey vector3(std::string name, Eigen::Vector3d& field) {
   return {
@@ -245,7 +263,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       integer("vio.keyframe_min_tracked", e.keyframe_min_tracked),
       number("vio.pixel_sigma_px", e.pixel_sigma_px),
       number("vio.huber_sigmas", e.huber_sigmas),
-      integer("vio.max_iterations", e.max_iterations),
+      integerOrAuto("vio.max_iterations", e.max_iterations),
       number("vio.min_depth_m", e.min_depth_m),
       number("vio.max_depth_m", e.max_depth_m),
       number("vio.max_reprojection_px", e.max_reprojection_px),

@@ -150,9 +150,31 @@ TEST(Config, FileErrors) {
   EXPECT_TRUE(errorOf({dir.path() / "empty.yaml", {}}).empty());
 }
 
+// vio.max_iterations: "auto" leaves the choice to the estimator's mode; a number is used as given.
+TEST(Config, SolverIterationsAreAutoOrAPositiveInteger) {
+  AppConfig c = loadConfig({std::nullopt, {}});
+  EXPECT_EQ(c.vio.estimator.max_iterations, 0);
+  EXPECT_THAT(dumpConfigYaml(c), HasSubstr("max_iterations: auto"));
+  c.vio.estimator.mode = odometry::VioMode::kStereoImu;
+  EXPECT_EQ(c.vio.estimator.solverIterations(), 2);
+  c.vio.estimator.mode = odometry::VioMode::kStereo;
+  EXPECT_EQ(c.vio.estimator.solverIterations(), 4);
+  c.vio.estimator.mode = odometry::VioMode::kMonoImu;
+  EXPECT_EQ(c.vio.estimator.solverIterations(), 4);
+  c = loadConfig({std::nullopt, {"vio.max_iterations=7"}});
+  EXPECT_EQ(c.vio.estimator.solverIterations(), 7);
+  EXPECT_THAT(dumpConfigYaml(c), HasSubstr("max_iterations: 7"));
+  EXPECT_THAT(errorOf({std::nullopt, {"vio.max_iterations=0"}}),
+              HasSubstr("expected auto or an integer >= 1"));
+  EXPECT_THAT(errorOf({std::nullopt, {"vio.max_iterations=many"}}),
+              HasSubstr("bad value 'many' for vio.max_iterations"));
+  EXPECT_THAT(errorOf({std::nullopt, {"vio.max_iterations=101"}}), HasSubstr("max_iterations"));
+}
+
 TEST(Config, DumpRoundTrips) {
   const AppConfig changed =
-      loadConfig({std::nullopt, {"dataset.gap_factor=3.25", "imu.acc_random_walk=1e-5"}});
+      loadConfig({std::nullopt,
+                  {"dataset.gap_factor=3.25", "imu.acc_random_walk=1e-5", "vio.max_iterations=3"}});
   test::TempDir dir("config");
   test::writeText(dir.path() / "dump.yaml", dumpConfigYaml(changed));
   EXPECT_EQ(dumpConfigYaml(loadConfig({dir.path() / "dump.yaml", {}})), dumpConfigYaml(changed));
