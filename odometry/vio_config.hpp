@@ -86,12 +86,11 @@ struct EstimatorConfig {
   double time_offset_min_rate_change_radps = 0.005;
   double time_offset_min_force_change_mps2 = 0.1;
 
-  // max_iterations, or by mode when 0: 2 with stereo+IMU, 4 otherwise. Each frame's solve starts
-  // from the previous frame's solution plus the IMU prediction, so with stereo depth and the IMU
-  // two Gauss-Newton (dogleg) steps reach the optimum's neighbourhood and more steps mostly fit
-  // noise: KITTI-00 3.316 -> 3.225 m APE with 27 % less estimator time, 14 of the 15 style-matrix
-  // drives better. Stereo alone and mono+IMU start further off and were not better with fewer
-  // (docs/vio_matrix.md, "Fewer solver iterations per frame").
+  // max_iterations, or by mode when 0: 2 with stereo+IMU, 4 otherwise. Measured, not derived:
+  // with stereo+IMU two iterations gave KITTI-00 3.316 -> 3.225 m APE with 27 % less estimator
+  // time and 14 of the 15 style-matrix drives better (the window solves each frame again at every
+  // frame it stays in; why fewer per frame is better was not isolated). Stereo alone and mono+IMU
+  // were not better with fewer (docs/vio_matrix.md, "Fewer solver iterations per frame").
   [[nodiscard]] int solverIterations() const;
   void validate() const;  // throws InvalidInput naming the field
 };

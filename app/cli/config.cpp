@@ -59,18 +59,17 @@ ConfigKey integer(std::string name, int& field) {
 
 // "auto" (stored as 0: the library picks by mode) or an integer >= 1.
 ConfigKey integerOrAuto(std::string name, int& field) {
-  ConfigKey plain = integer(name, field);
   return {name,
-          [name, &field, set = plain.set](std::string_view v) {
-            if (v == "auto") {
-              field = 0;
-              return;
+          [name, &field](std::string_view v) {
+            int parsed = 0;
+            if (v != "auto") {
+              integer(name, parsed).set(v);
+              if (parsed < 1) {
+                throw InvalidInput(fmt::format(
+                    "bad value '{}' for {}: expected auto or an integer >= 1", v, name));
+              }
             }
-            set(v);
-            if (field < 1) {
-              throw InvalidInput(
-                  fmt::format("bad value '{}' for {}: expected auto or an integer >= 1", v, name));
-            }
+            field = parsed;  // only once the value is known good
           },
           [&field] { return field == 0 ? std::string("auto") : std::to_string(field); }};
 }
