@@ -111,7 +111,8 @@ bool MapBuilder::denseTurn(std::size_t index, const Eigen::Isometry3d& T_w_b) co
 
 bool MapBuilder::landmarkAccepted(const StoredLandmark& lm) const {
   return lm.observations >= config_.sparse.min_landmark_observations &&
-         lm.mean_reprojection_px <= config_.sparse.max_landmark_reprojection_px;
+         lm.mean_reprojection_px <= config_.sparse.max_landmark_reprojection_px &&
+         lm.p_b.norm() <= config_.sparse.max_landmark_range_m;
 }
 
 std::vector<std::vector<std::uint64_t>> MapBuilder::attachedLandmarks() const {

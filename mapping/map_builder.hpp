@@ -46,7 +46,8 @@ struct MapCounts {
   std::size_t keyframes_used = 0;     // with a pose in the target frame
   std::size_t keyframes_skipped = 0;  // pose_of returned nullopt
   std::size_t landmarks_stored = 0;
-  std::size_t landmarks_rejected = 0;  // too few observations or too large a reprojection error
+  // too few observations, too large a reprojection error, or too far (sparse.max_landmark_range_m)
+  std::size_t landmarks_rejected = 0;
   std::size_t landmarks_unplaced = 0;  // their keyframe had no pose
   std::size_t sparse_points = 0;
   std::size_t dense_points_raw = 0;    // keyframe points placed in the target frame

@@ -25,6 +25,7 @@ void MapConfig::validate() const {
   require(sparse.min_landmark_observations >= 2, "sparse.min_landmark_observations", ">= 2");
   require(positive(sparse.max_landmark_reprojection_px), "sparse.max_landmark_reprojection_px",
           "> 0");
+  require(positive(sparse.max_landmark_range_m), "sparse.max_landmark_range_m", "> 0");
 
   require(dense.every_n_keyframes >= 1, "dense.every_n_keyframes", ">= 1");
   require(std::isfinite(dense.min_spacing_m) && dense.min_spacing_m >= 0.0, "dense.min_spacing_m",

@@ -10,6 +10,10 @@ struct SparseMapConfig {
   // The VIO's pixel noise is 1 px (vio.pixel_sigma_px); a mean residual above 1.5 sigma marks a
   // landmark the window fitted badly (occlusion boundary, repeated texture).
   double max_landmark_reprojection_px = 1.5;
+  // The VIO keeps landmarks up to vio.max_depth_m (1000 m) for what they say about its rotation,
+  // but their stereo depth is poor there (a 0.5 px disparity error at 300 m on KITTI's pair is
+  // 100 m): landmarks farther than this from their keyframe are left out of the map.
+  double max_landmark_range_m = 80.0;
 };
 
 // cv::StereoSGBM (Hirschmueller 2008) on the rectified pair, run at `downscale` x resolution.

@@ -63,6 +63,7 @@ void OccupancyBuilder::insert(const CameraCloud& points_map, const Eigen::Vector
 }
 
 void OccupancyBuilder::compact() {
+  if (tree_->getRoot() == nullptr) return;  // nothing inserted (see finish())
   tree_->updateInnerOccupancy();
   tree_->prune();
   nodes_after_compact_ = tree_->size();
@@ -80,8 +81,12 @@ OccupancyBuilder::Trees OccupancyBuilder::finish() {
                           node != nullptr ? node->getLogOdds() : tree_->getClampingThresMinLog());
   }
   for (const auto& [key, value] : log_odds) color_tree_->setNodeValue(key, value, true);
-  color_tree_->updateInnerOccupancy();
-  color_tree_->prune();
+  // ColorOcTree::updateInnerOccupancy (OctoMap 1.9) walks from the root without checking it: a
+  // map whose every point lies beyond max_range_m (far landmarks only) has none.
+  if (color_tree_->getRoot() != nullptr) {
+    color_tree_->updateInnerOccupancy();
+    color_tree_->prune();
+  }
   Trees trees;
   trees.occupancy = std::move(tree_);
   trees.color = std::move(color_tree_);

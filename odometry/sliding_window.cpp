@@ -317,11 +317,13 @@ void SlidingWindow::marginalizeOldest(bool use_imu) {
       m.addResidualBlock(std::move(cost), std::shared_ptr<const ceres::LossFunction>(huber_, loss),
                          blocks);
     };
+    std::vector<std::uint64_t> folded;
     for (auto& [id, lm] : landmarks_.all()) {
       if (lm.anchor().frame_uid != oldest.uid) continue;
       if (landmarkFactors(lm, sink, with_time_offset) > 0) {
         m.markForRemoval(&lm.inv_depth);
         pose_named = true;
+        folded.push_back(id);
       }
     }
     // The t_d prior is folded in once, with the first factors that take t_d into the prior.
@@ -346,6 +348,17 @@ void SlidingWindow::marginalizeOldest(bool use_imu) {
     } catch (const std::exception&) {
       // A degenerate linearisation (it should not happen) costs the prior, never the run.
       prior_.reset();
+    }
+    // A landmark folded into the prior took every observation it has in the window with it, so
+    // it leaves too. Re-anchoring it in its next observation (VINS-Mono's removeBackShiftDepth)
+    // would put those observations into the solve a second time, and again at every later
+    // marginalisation: a feature tracked through the whole window then counts up to window_size
+    // times, the window grows overconfident in vision, and the tilt / accelerometer-bias pair,
+    // unobservable on a straight, follows whatever the images pull (docs/vio_matrix.md, "Each
+    // observation counted once"). Its track goes on: the next keyframe that sees it starts a new
+    // landmark there. (EstimatorConfig::foldedLandmarksDropped says where it is done.)
+    if (prior_ && config_.foldedLandmarksDropped()) {
+      for (const std::uint64_t id : folded) landmarks_.all().erase(id);
     }
   } else {
     prior_.reset();

@@ -93,7 +93,8 @@ class SlidingWindow {
   // blocks are variables); without a prior the oldest pose is held fixed (the gauge).
   SolveStats solve(bool use_imu);
   // Folds the oldest frame (its pose, speed/bias, and the landmarks anchored in it) into the
-  // prior and removes it from the window.
+  // prior and removes it from the window. The landmarks folded in leave with it: their
+  // observations in the frames that stay are already in the prior (see the definition).
   void marginalizeOldest(bool use_imu);
   // Removes the newest frame without keeping its information (a non-keyframe: VINS drops their
   // visual measurements too; its IMU is re-integrated from the previous keyframe).

@@ -42,6 +42,31 @@ VioMode parseVioMode(const std::string& name) {
                      "')");
 }
 
+std::string toString(FoldedLandmarks policy) {
+  switch (policy) {
+    case FoldedLandmarks::kAuto:
+      return "auto";
+    case FoldedLandmarks::kDrop:
+      return "drop";
+    case FoldedLandmarks::kReanchor:
+      return "reanchor";
+  }
+  return "?";
+}
+
+FoldedLandmarks parseFoldedLandmarks(const std::string& name) {
+  if (name == "auto") return FoldedLandmarks::kAuto;
+  if (name == "drop") return FoldedLandmarks::kDrop;
+  if (name == "reanchor") return FoldedLandmarks::kReanchor;
+  throw InvalidInput("config: vio.folded_landmarks must be one of auto, drop, reanchor (got '" +
+                     name + "')");
+}
+
+bool EstimatorConfig::foldedLandmarksDropped() const {
+  if (folded_landmarks == FoldedLandmarks::kAuto) return usesImu(mode);
+  return folded_landmarks == FoldedLandmarks::kDrop;
+}
+
 int EstimatorConfig::solverIterations() const {
   if (max_iterations > 0) return max_iterations;
   return mode == VioMode::kStereoImu ? 2 : 4;

@@ -74,6 +74,18 @@ ConfigKey integerOrAuto(std::string name, int& field) {
           [&field] { return field == 0 ? std::string("auto") : std::to_string(field); }};
 }
 
+ConfigKey foldedLandmarks(std::string name, odometry::FoldedLandmarks& field) {
+  return {name,
+          [name, &field](std::string_view v) {
+            if (v != "auto" && v != "drop" && v != "reanchor") {
+              throw InvalidInput(
+                  fmt::format("bad value '{}' for {}: expected auto, drop or reanchor", v, name));
+            }
+            field = odometry::parseFoldedLandmarks(std::string(v));
+          },
+          [&field] { return odometry::toString(field); }};
+}
+
 // Vectors are written "x,y,z" (a YAML sequence flattens to that form).
 ConfigKey vector3(std::string name, Eigen::Vector3d& field) {
   return {
@@ -265,6 +277,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       integerOrAuto("vio.max_iterations", e.max_iterations),
       number("vio.min_depth_m", e.min_depth_m),
       number("vio.max_depth_m", e.max_depth_m),
+      foldedLandmarks("vio.folded_landmarks", e.folded_landmarks),
       number("vio.max_reprojection_px", e.max_reprojection_px),
       number("vio.static_gyr_radps", e.static_gyr_radps),
       number("vio.static_acc_mps2", e.static_acc_mps2),
@@ -341,6 +354,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       boolean("map.enabled", c.map.enabled),
       integer("map.sparse.min_landmark_observations", m.sparse.min_landmark_observations),
       number("map.sparse.max_landmark_reprojection_px", m.sparse.max_landmark_reprojection_px),
+      number("map.sparse.max_landmark_range_m", m.sparse.max_landmark_range_m),
       boolean("map.dense.enabled", m.dense.enabled),
       integer("map.dense.every_n_keyframes", m.dense.every_n_keyframes),
       number("map.dense.min_spacing_m", m.dense.min_spacing_m),

@@ -29,14 +29,19 @@ nlohmann::json driveNamed(const nlohmann::json& fleet, const std::string& name) 
   return {};
 }
 
+// The 6 s drive covers 40 m, whose fixes spread exactly the registration's default 20 m from
+// their centre: with the default a millimetre of VIO decides whether drive b is georeferenced.
+constexpr const char* kShortDriveRegistration = "--set fusion.alignment_min_extent_m=15";
+
 TEST(CliFleet, RunsDrivesTogetherReportsAFailedOneAndResumes) {
   const TempDir dir("cli_fleet");
   const fs::path list = dir.path() / "drives.txt";
   writeText(list, fmt::format("# two drives and one that does not exist\n"
                               "{} --name a --gnss off --set loops.enabled=false\n"
-                              "{} --name b {}\n"
+                              "{} --name b {} {}\n"
                               "missing_drive\n",
-                              shortDrive(11).string(), shortDrive(12).string(), kSimGeo));
+                              shortDrive(11).string(), shortDrive(12).string(), kSimGeo,
+                              kShortDriveRegistration));
   const fs::path out = dir.path() / "fleet";
   const CommandResult r =
       runGvio(fmt::format("fleet --drives {} --out {} --jobs 2", quoted(list), quoted(out)));
@@ -68,8 +73,9 @@ TEST(CliFleet, RunsDrivesTogetherReportsAFailedOneAndResumes) {
   // Again, one drive at a time: the complete drives are reused (their --threads changed with
   // --jobs, which does not change a run's output), and a drive whose options changed runs again.
   writeText(list, fmt::format("{} --name a --gnss off --set loops.enabled=false\n"
-                              "{} --name b {} --seed 5\n",
-                              shortDrive(11).string(), shortDrive(12).string(), kSimGeo));
+                              "{} --name b {} {} --seed 5\n",
+                              shortDrive(11).string(), shortDrive(12).string(), kSimGeo,
+                              kShortDriveRegistration));
   const CommandResult again =
       runGvio(fmt::format("fleet --drives {} --out {} --jobs 1", quoted(list), quoted(out)));
   EXPECT_EQ(again.exit_code, 0) << again.err;

@@ -171,10 +171,31 @@ TEST(Config, SolverIterationsAreAutoOrAPositiveInteger) {
   EXPECT_THAT(errorOf({std::nullopt, {"vio.max_iterations=101"}}), HasSubstr("max_iterations"));
 }
 
+TEST(Config, FoldedLandmarksAreDroppedWithTheImuUnlessSet) {
+  AppConfig c = loadConfig({std::nullopt, {}});
+  EXPECT_EQ(c.vio.estimator.folded_landmarks, odometry::FoldedLandmarks::kAuto);
+  EXPECT_THAT(dumpConfigYaml(c), HasSubstr("folded_landmarks: auto"));
+  c.vio.estimator.mode = odometry::VioMode::kStereoImu;
+  EXPECT_TRUE(c.vio.estimator.foldedLandmarksDropped());
+  c.vio.estimator.mode = odometry::VioMode::kMonoImu;
+  EXPECT_TRUE(c.vio.estimator.foldedLandmarksDropped());
+  c.vio.estimator.mode = odometry::VioMode::kStereo;
+  EXPECT_FALSE(c.vio.estimator.foldedLandmarksDropped());
+  c = loadConfig({std::nullopt, {"vio.folded_landmarks=reanchor"}});
+  EXPECT_FALSE(c.vio.estimator.foldedLandmarksDropped());
+  EXPECT_THAT(dumpConfigYaml(c), HasSubstr("folded_landmarks: reanchor"));
+  c = loadConfig({std::nullopt, {"vio.folded_landmarks=drop"}});
+  c.vio.estimator.mode = odometry::VioMode::kStereo;  // the run picks it for the dataset
+  EXPECT_TRUE(c.vio.estimator.foldedLandmarksDropped());
+  EXPECT_THAT(errorOf({std::nullopt, {"vio.folded_landmarks=keep"}}),
+              HasSubstr("bad value 'keep' for vio.folded_landmarks: expected auto, drop or "
+                        "reanchor"));
+}
+
 TEST(Config, DumpRoundTrips) {
-  const AppConfig changed =
-      loadConfig({std::nullopt,
-                  {"dataset.gap_factor=3.25", "imu.acc_random_walk=1e-5", "vio.max_iterations=3"}});
+  const AppConfig changed = loadConfig({std::nullopt,
+                                        {"dataset.gap_factor=3.25", "imu.acc_random_walk=1e-5",
+                                         "vio.max_iterations=3", "vio.folded_landmarks=reanchor"}});
   test::TempDir dir("config");
   test::writeText(dir.path() / "dump.yaml", dumpConfigYaml(changed));
   EXPECT_EQ(dumpConfigYaml(loadConfig({dir.path() / "dump.yaml", {}})), dumpConfigYaml(changed));

@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "mapping/map_builder.hpp"
+#include "mapping/occupancy_builder.hpp"
 #include "odometry/error.hpp"
 #include "support/kitti_camera.hpp"
 
@@ -128,6 +129,47 @@ TEST(MappingBuilder, SparseFiltersOnObservationsAndReprojection) {
   EXPECT_EQ(map.counts.landmarks_stored, 4u);
   EXPECT_EQ(map.counts.landmarks_rejected, 2u);
   EXPECT_EQ(map.counts.sparse_points, 2u);
+}
+
+TEST(MappingBuilder, SparseLeavesOutLandmarksBeyondItsRange) {
+  // The VIO keeps far landmarks for their rotation information; the map takes them up to
+  // sparse.max_landmark_range_m (80 m) from their keyframe only.
+  MapConfig config = sparseOnly();
+  MapBuilder builder(config, camera(), 0.0);
+  const Eigen::Isometry3d T_w_b = pose(0.0, {100, 0, 0});
+  builder.addKeyframe(1, T_w_b, cv::Mat(), cv::Mat(),
+                      {landmark(1, {179, 0, 0}, 5, 0.5), landmark(2, {181, 0, 0}, 6, 0.5),
+                       landmark(3, {400, 0, 0}, 7, 0.5)});
+  const MapBuildResult map = builder.build(builder.vioPoses());
+  ASSERT_EQ(map.sparse.size(), 1u);
+  EXPECT_EQ(map.sparse[0].observations, 5u);
+  EXPECT_EQ(map.counts.landmarks_rejected, 2u);
+  config.sparse.max_landmark_range_m = 500.0;
+  MapBuilder wide(config, camera(), 0.0);
+  wide.addKeyframe(1, T_w_b, cv::Mat(), cv::Mat(),
+                   {landmark(1, {179, 0, 0}, 5, 0.5), landmark(2, {181, 0, 0}, 6, 0.5),
+                    landmark(3, {400, 0, 0}, 7, 0.5)});
+  EXPECT_EQ(wide.build(wide.vioPoses()).sparse.size(), 3u);
+}
+
+TEST(MappingOccupancy, PointsAllBeyondTheRangeClearSpaceAndColourNothing) {
+  // OctoMap 1.9's ColorOcTree::updateInnerOccupancy does not check for an empty tree: a map
+  // whose points all lie beyond occupancy.max_range_m (30 m) crashed there.
+  OccupancyBuilder builder(OccupancyConfig{});
+  CameraCloud far;
+  pcl::PointXYZI p;
+  p.x = 100.0F;
+  p.y = 0.0F;
+  p.z = 0.0F;
+  p.intensity = 50.0F;
+  far.push_back(p);
+  builder.insert(far, Eigen::Vector3d::Zero());
+  const OccupancyBuilder::Trees trees = builder.finish();
+  EXPECT_EQ(trees.color->getNumLeafNodes(), 0u);
+  EXPECT_GT(trees.occupancy->getNumLeafNodes(), 0u);  // the ray's first 30 m, free
+  const OccupancyBuilder::Trees none = OccupancyBuilder(OccupancyConfig{}).finish();
+  EXPECT_EQ(none.occupancy->getNumLeafNodes(), 0u);
+  EXPECT_EQ(none.color->getNumLeafNodes(), 0u);
 }
 
 TEST(MappingBuilder, LandmarkIntensityIsSampledWhereItProjects) {
@@ -410,6 +452,9 @@ TEST(MappingConfig, DefaultsValidateAndBadValuesThrow) {
   EXPECT_THROW(c.validate(), InvalidInput);
   c = MapConfig{};
   c.sparse.min_landmark_observations = 1;
+  EXPECT_THROW(c.validate(), InvalidInput);
+  c = MapConfig{};
+  c.sparse.max_landmark_range_m = 0.0;
   EXPECT_THROW(c.validate(), InvalidInput);
   c = MapConfig{};
   c.dense.voxel_size_m = 0.01;

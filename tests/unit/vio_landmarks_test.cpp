@@ -7,25 +7,13 @@
 
 #include "odometry/landmarks.hpp"
 #include "odometry/pose_manifold.hpp"
+#include "support/stereo_rig.hpp"
 
 namespace gvio::odometry {
 namespace {
 
-StereoGeometry stereoRig() {
-  StereoGeometry g;
-  g.left = {500.0, 500.0, 320.0, 240.0, Eigen::Isometry3d::Identity()};
-  g.right = g.left;
-  g.right.T_b_c.translation() = Eigen::Vector3d(0.5, 0.0, 0.0);
-  g.stereo = true;
-  g.baseline_m = 0.5;
-  return g;
-}
-
-Eigen::Vector2d project(const PinholeView& view, const Eigen::Isometry3d& T_w_b,
-                        const Eigen::Vector3d& p_w) {
-  const Eigen::Vector3d p_c = (T_w_b * view.T_b_c).inverse() * p_w;
-  return {view.fx * p_c.x() / p_c.z() + view.cx, view.fy * p_c.y() / p_c.z() + view.cy};
-}
+using test::project;
+using test::stereoRig;
 
 class LandmarkReprojection : public ::testing::Test {
  protected:
