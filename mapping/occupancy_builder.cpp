@@ -63,7 +63,6 @@ void OccupancyBuilder::insert(const CameraCloud& points_map, const Eigen::Vector
 }
 
 void OccupancyBuilder::compact() {
-  if (tree_->getRoot() == nullptr) return;  // nothing inserted (see finish())
   tree_->updateInnerOccupancy();
   tree_->prune();
   nodes_after_compact_ = tree_->size();

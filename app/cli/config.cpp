@@ -77,11 +77,13 @@ ConfigKey integerOrAuto(std::string name, int& field) {
 ConfigKey foldedLandmarks(std::string name, odometry::FoldedLandmarks& field) {
   return {name,
           [name, &field](std::string_view v) {
-            if (v != "auto" && v != "drop" && v != "reanchor") {
+            // The library's parser decides which names exist; the message takes this file's form.
+            try {
+              field = odometry::parseFoldedLandmarks(std::string(v));
+            } catch (const InvalidInput&) {
               throw InvalidInput(
                   fmt::format("bad value '{}' for {}: expected auto, drop or reanchor", v, name));
             }
-            field = odometry::parseFoldedLandmarks(std::string(v));
           },
           [&field] { return odometry::toString(field); }};
 }
