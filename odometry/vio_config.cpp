@@ -92,6 +92,7 @@ void EstimatorConfig::validate() const {
   require(positive(init_window_s), "init_window_s", "> 0");
   require(positive(init_max_tilt_sigma_deg), "init_max_tilt_sigma_deg", "> 0");
   require(nonNegative(init_max_wait_s), "init_max_wait_s", ">= 0");
+  require(nonNegative(init_alignment_span_s), "init_alignment_span_s", ">= 0");
   require(positive(max_imu_gap_s), "max_imu_gap_s", "> 0");
   require(positive(init_tilt_sigma_deg), "init_tilt_sigma_deg", "> 0");
   require(positive(init_velocity_sigma_mps), "init_velocity_sigma_mps", "> 0");

@@ -67,6 +67,11 @@ struct EstimatorConfig {
   // it initialises anyway, with the tilt prior widened to the alignment's sigma.
   double init_max_tilt_sigma_deg = 1.0;
   double init_max_wait_s = 5.0;
+  // While it waits, the moving stereo window keeps the poses of the frames it marginalises, and
+  // the alignment reaches back over them up to this span before its newest frame: the gravity
+  // direction comes from the visual positions' curvature against the IMU's, whose tilt leak grows
+  // as the span squared. 0 = the window's own frames only.
+  double init_alignment_span_s = 5.0;
   double max_imu_gap_s = 0.1;      // longer gaps without IMU: coast on the visual solution
   int min_features_tracking = 15;  // fewer usable features: the frame is lost (coast/reinit)
   // Priors on the state the IMU window starts from (after initialisation or a restart). With the

@@ -120,6 +120,7 @@ void VioEstimator::Impl::restart(std::int64_t t_ns, const std::string& kind, con
   if (!keep_imu_alignment) imu_aligned = false;
   coast_start_ns = -1;
   uncertain_alignment_since_ns = -1;
+  alignment_history.clear();
   if (keep_imu_alignment && latest.valid) ++counters.initializations;
 }
 
@@ -243,7 +244,10 @@ void VioEstimator::Impl::finishFrame(const WindowFrame& f) {
   latest = stateOf(f);
   if (f.keyframe) {
     ++counters.keyframes;
-    while (window.keyframeCount() > config.window_size) window.marginalizeOldest(imuActive());
+    while (window.keyframeCount() > config.window_size) {
+      if (keepsAlignmentHistory()) keepForAlignment(*window.frames().front());
+      window.marginalizeOldest(imuActive());
+    }
   } else {
     window.dropNewest();
   }
@@ -253,6 +257,11 @@ void VioEstimator::Impl::finishFrame(const WindowFrame& f) {
   // Before the alignment the window may be re-timed (retimeWindow): its IMU is kept, with a margin.
   if (config.estimate_time_offset && !imu_aligned && !window.frames().empty()) {
     keep = std::min(keep, window.frames().front()->stateNs() - kRetimeImuMarginNs);
+  }
+  // ... and so is that of the frames kept for it (prependHistory).
+  if (!imu_aligned && !alignment_history.empty() && !window.frames().empty()) {
+    keep = std::min(keep, alignment_history.front().t_ns - window.frames().front()->retime_ns -
+                              kRetimeImuMarginNs);
   }
   imu.dropBefore(std::min(keep, latest.t_ns));
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -96,8 +97,23 @@ struct VioEstimator::Impl {
   // The visual-inertial alignment of `af` (the window's frames) with the t_d prior it is given
   // (`prior`, set here); when it observes t_d the window is re-timed to it (retimeWindow) and the
   // alignment runs again, with `af`'s preintegrations and `prior` taken from the re-timed window.
+  // `history` is how many frames of alignment_history lead `af` (prependHistory); they are
+  // rebuilt at the new re-timing.
   std::optional<AlignmentResult> alignRetimed(std::vector<AlignmentFrame>& af, bool mono,
-                                              std::optional<TimeOffsetPrior>& prior);
+                                              std::optional<TimeOffsetPrior>& prior,
+                                              std::size_t& history);
+  // The moving stereo window's frames for the alignment (visual poses, IMU between them).
+  [[nodiscard]] std::vector<AlignmentFrame> windowAlignmentFrames() const;
+  // True while marginalised frames are kept for the alignment (a moving stereo window with the
+  // IMU, not yet aligned, init_alignment_span_s > 0).
+  [[nodiscard]] bool keepsAlignmentHistory() const;
+  // Keeps the pose of `f`, about to be marginalised, for the alignment; forgets what lies more
+  // than init_alignment_span_s before the newest frame.
+  void keepForAlignment(const WindowFrame& f);
+  // Puts the kept frames (those the IMU covers without a gap, back from the window's oldest) in
+  // front of the window's frames `af`, with the IMU between them at the window's re-timing;
+  // returns how many.
+  std::size_t prependHistory(std::vector<AlignmentFrame>& af) const;
   // Moves the window's poses from the exposures to the stamps by the alignment's t_d.
   void moveToStamps(const AlignmentResult& result);
   void reportWaiting(std::int64_t t_ns, const std::string& why);
@@ -122,6 +138,13 @@ struct VioEstimator::Impl {
   std::optional<Eigen::Isometry3d> previous_pose;  // the frame before `latest` (constant velocity)
   bool imu_aligned = false;  // the window is gravity-aligned with velocities and biases
   bool waiting_reported = false;
+  // Frames the vision-only stereo window marginalised while waiting for its alignment: pose in the
+  // visual frame and stamp (keepForAlignment).
+  struct PastFrame {
+    std::int64_t t_ns = 0;
+    Eigen::Isometry3d T_v_b = Eigen::Isometry3d::Identity();
+  };
+  std::deque<PastFrame> alignment_history;
   // The first alignment that was refused as too uncertain in tilt (-1: none since the last start).
   std::int64_t uncertain_alignment_since_ns = -1;
   std::uint64_t next_uid = 1;

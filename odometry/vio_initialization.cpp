@@ -89,6 +89,7 @@ void VioEstimator::Impl::applyAlignment(const Eigen::Matrix3d& R_w_v,
   latest.valid = false;
   previous_pose.reset();
   imu_aligned = true;
+  alignment_history.clear();
   anchorWindow(tilt_sigma_rad);
   ++counters.initializations;
 }
@@ -130,32 +131,33 @@ bool VioEstimator::Impl::motionInitialize(std::int64_t t_ns) {
       config.init_window_s) {
     return false;
   }
-  std::vector<AlignmentFrame> af;
-  for (std::size_t k = 0; k < frames.size(); ++k) {
-    if (k > 0 && !frames[k]->preintegration) return false;
-    AlignmentFrame a;
-    const Eigen::Isometry3d T = frames[k]->T_w_b();
-    a.R_v_b = T.rotation();
-    a.p_v_b = T.translation();
-    if (k > 0) a.preintegration = frames[k]->preintegration;
-    af.push_back(a);
-  }
+  std::vector<AlignmentFrame> af = windowAlignmentFrames();
+  if (af.empty()) return false;
+  std::size_t history = prependHistory(af);
   std::optional<TimeOffsetPrior> t_d_prior;
-  const auto result = alignRetimed(af, false, t_d_prior);
+  auto result = alignRetimed(af, false, t_d_prior, history);
   if (!result) {
     reportWaiting(t_ns, "visual-inertial alignment not yet well conditioned: waiting");
     return false;
   }
   if (!tiltCertainEnough(t_ns, result->tilt_sigma_rad)) return false;
+  // The kept frames have served: the window's own frames follow them.
+  const auto kept = static_cast<std::ptrdiff_t>(history);
+  result->v_v.erase(result->v_v.begin(), result->v_v.begin() + kept);
+  if (!result->w_b.empty()) result->w_b.erase(result->w_b.begin(), result->w_b.begin() + kept);
+  const std::int64_t first_ns = history > 0
+                                    ? alignment_history[alignment_history.size() - history].t_ns
+                                    : frames.front()->t_ns;
   ImuBias bias;
   bias.gyr = result->gyr_bias;
   moveToStamps(*result);
   if (t_d_prior) setInitialTimeOffset(*result);
   applyAlignment(result->R_w_v, result->v_v, bias, result->tilt_sigma_rad);
   event(t_ns, "initialized",
-        "visual-inertial alignment over " + std::to_string(frames.size()) +
-            " frames: |g| before refinement " + fmt3(result->gravity_norm_before_refinement) +
-            " m/s^2, tilt +- " + fmt3(result->tilt_sigma_rad * 180.0 / M_PI) + " deg, gyro bias " +
+        "visual-inertial alignment over " + std::to_string(af.size()) + " frames (" +
+            fmt3(static_cast<double>(t_ns - first_ns) * 1e-9) + " s): |g| before refinement " +
+            fmt3(result->gravity_norm_before_refinement) + " m/s^2, tilt +- " +
+            fmt3(result->tilt_sigma_rad * 180.0 / M_PI) + " deg, gyro bias " +
             fmt3(bias.gyr.norm() * 180.0 / M_PI) + " deg/s" +
             timeOffsetText(t_d_prior, *result, windowRetimeS()));
   return true;
@@ -220,7 +222,8 @@ bool VioEstimator::Impl::monoInitialize(std::int64_t t_ns) {
     if (k > 0) af[k].preintegration = frames[k]->preintegration;
   }
   std::optional<TimeOffsetPrior> t_d_prior;
-  const auto result = alignRetimed(af, true, t_d_prior);
+  std::size_t no_history = 0;
+  const auto result = alignRetimed(af, true, t_d_prior, no_history);
   if (!result) {
     reportWaiting(t_ns,
                   "mono+IMU: scale not yet observable (SfM solved, alignment waits for "
@@ -262,15 +265,19 @@ bool VioEstimator::Impl::monoInitialize(std::int64_t t_ns) {
 }
 
 std::optional<AlignmentResult> VioEstimator::Impl::alignRetimed(
-    std::vector<AlignmentFrame>& af, bool mono, std::optional<TimeOffsetPrior>& prior) {
+    std::vector<AlignmentFrame>& af, bool mono, std::optional<TimeOffsetPrior>& prior,
+    std::size_t& history) {
   prior = timeOffsetPrior();
   auto result = alignVisualInertial(af, mono, 0.1, 0.05, prior);
   if (!result || !prior || !result->t_d_observed ||
       !retimeWindow(windowRetimeS() + result->t_d_s)) {
     return result;
   }
+  af.erase(af.begin(), af.begin() + static_cast<std::ptrdiff_t>(history));
   const auto& frames = window.frames();
+  af.front().preintegration = nullptr;
   for (std::size_t k = 1; k < frames.size(); ++k) af[k].preintegration = frames[k]->preintegration;
+  history = prependHistory(af);
   prior = timeOffsetPrior();
   return alignVisualInertial(af, mono, 0.1, 0.05, prior);
 }

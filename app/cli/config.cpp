@@ -287,6 +287,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("vio.init_window_s", e.init_window_s),
       number("vio.init_max_tilt_sigma_deg", e.init_max_tilt_sigma_deg),
       number("vio.init_max_wait_s", e.init_max_wait_s),
+      number("vio.init_alignment_span_s", e.init_alignment_span_s),
       number("vio.max_imu_gap_s", e.max_imu_gap_s),
       integer("vio.min_features_tracking", e.min_features_tracking),
       number("vio.init_tilt_sigma_deg", e.init_tilt_sigma_deg),
