@@ -30,9 +30,18 @@ struct TrackerConfig {
   // window, which made the VIO's trajectories 0.04-0.8 % short; the small window reduces the
   // deformation it averages over, while the pyramid (large window) still finds large motions.
   int klt_refine_window_px = 7;
-  double fb_threshold_px = 1.0;         // forward-backward check: max round-trip miss
-  double ransac_threshold_px = 1.0;     // fundamental-matrix RANSAC between consecutive left frames
-  double stereo_max_vertical_px = 2.0;  // rectified stereo: reject matches off the epipolar line
+  // KLT starts every track shifted by the frame's common image motion (the tracks' median image
+  // velocity times the interval) when that shift is at least this (px), else at its old position;
+  // 0 always shifts, a huge value never (FeatureTracker::predictedPositions).
+  double klt_predict_min_px = 10.0;
+  double fb_threshold_px = 1.0;      // forward-backward check: max round-trip miss
+  double ransac_threshold_px = 1.0;  // fundamental-matrix RANSAC between consecutive left frames
+  // Rectified stereo: a match further than this from the frame's median row offset (right y -
+  // left y over its candidate matches) is rejected. KLT on an oblique edge (a lane marking, a
+  // wall's edge) slides along it, off the row and to a wrong disparity; the median is the offset
+  // a rig's rectification error gives every match alike (docs/vio_matrix.md, "The stereo row
+  // check").
+  double stereo_max_vertical_px = 0.5;
   bool stereo = true;
 
   void validate() const;  // throws InvalidInput naming the field
@@ -65,6 +74,7 @@ struct TrackerStats {
   int rejected_ransac = 0;
   int stereo_matches = 0;
   int rejected_stereo = 0;  // stereo KLT failures, forward-backward, epipolar or disparity sign
+  double stereo_row_offset_px = 0.0;  // the frame's median right y - left y (0: no candidates)
   // Informational wall-clock timings of the three stages (not asserted anywhere).
   double ms_detect = 0, ms_track = 0, ms_stereo = 0;
 };
@@ -117,6 +127,7 @@ class FeatureTracker {
   void checkImages(const cv::Mat& left, const cv::Mat& right) const;
   void buildPyramid(const cv::Mat& image, std::vector<cv::Mat>& pyr) const;
   void trackPrevious(double dt_s, TrackerStats& stats);
+  [[nodiscard]] std::vector<cv::Point2f> predictedPositions(double dt_s) const;
   void rejectOutliersRansac(const std::vector<cv::Point2f>& prev_px, TrackerStats& stats);
   void thinOutAndMask(const cv::Size& size);
   std::vector<cv::Point2f> shiTomasiCorners(const cv::Mat& image);
