@@ -444,7 +444,7 @@ std::vector<Feature> FeatureTracker::matchStereo(TrackerStats& stats) {
         candidate[i] && inside(right_px[i], image_size_) && right_px[i].x <= left_px[i].x;
   }
   const float row_offset = medianRowOffset(left_px, right_px, candidate);
-  stats.stereo_row_offset_px = row_offset;
+  stats.stereo_row_offset_px = static_cast<double>(row_offset);
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
     Track& t = tracks_[i];
     const cv::Point2f& l = left_px[i];
