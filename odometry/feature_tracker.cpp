@@ -46,9 +46,15 @@ constexpr int kReverseLevels = 1;
 
 using Clock = std::chrono::steady_clock;
 
+// The upper median of a non-empty set (one of its values, never an average of two); reorders it.
+float upperMedian(std::vector<float>& values) {
+  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
+}
+
 // Median of right y - left y over the stereo candidates (KLT converged, inside the image,
-// disparity not negative); 0 without any. The upper median of an even count: one of the offsets,
-// never an average of two.
+// disparity not negative); 0 without any.
 float medianRowOffset(const std::vector<cv::Point2f>& left_px,
                       const std::vector<cv::Point2f>& right_px,
                       const std::vector<bool>& candidate) {
@@ -57,10 +63,7 @@ float medianRowOffset(const std::vector<cv::Point2f>& left_px,
   for (std::size_t i = 0; i < left_px.size(); ++i) {
     if (candidate[i]) offsets.push_back(right_px[i].y - left_px[i].y);
   }
-  if (offsets.empty()) return 0.0F;
-  const auto mid = offsets.begin() + static_cast<std::ptrdiff_t>(offsets.size() / 2);
-  std::nth_element(offsets.begin(), mid, offsets.end());
-  return *mid;
+  return offsets.empty() ? 0.0F : upperMedian(offsets);
 }
 
 double msSince(Clock::time_point start) {
@@ -303,12 +306,8 @@ std::vector<cv::Point2f> FeatureTracker::predictedPositions(double dt_s) const {
     vy.push_back(t.velocity_pxps.y);
   }
   if (vx.empty()) return start;
-  const auto median = [](std::vector<float>& v) {
-    const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-    std::nth_element(v.begin(), mid, v.end());
-    return *mid;
-  };
-  const cv::Point2f shift = cv::Point2f(median(vx), median(vy)) * static_cast<float>(dt_s);
+  const cv::Point2f shift =
+      cv::Point2f(upperMedian(vx), upperMedian(vy)) * static_cast<float>(dt_s);
   if (std::hypot(static_cast<double>(shift.x), static_cast<double>(shift.y)) <
       config_.klt_predict_min_px) {
     return start;
