@@ -74,6 +74,23 @@ ConfigKey integerOrAuto(std::string name, int& field) {
           [&field] { return field == 0 ? std::string("auto") : std::to_string(field); }};
 }
 
+// "auto" (stored as 0: the run picks by mode) or a number > 0.
+ConfigKey numberOrAuto(std::string name, double& field) {
+  return {name,
+          [name, &field](std::string_view v) {
+            double parsed = 0.0;
+            if (v != "auto") {
+              parsed = parseDouble(name, v);
+              if (parsed <= 0.0) {
+                throw InvalidInput(fmt::format(
+                    "bad value '{}' for {}: expected auto or a positive number", v, name));
+              }
+            }
+            field = parsed;  // only once the value is known good
+          },
+          [&field] { return field == 0.0 ? std::string("auto") : formatDouble(field); }};
+}
+
 ConfigKey foldedLandmarks(std::string name, odometry::FoldedLandmarks& field) {
   return {name,
           [name, &field](std::string_view v) {
@@ -318,10 +335,10 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       integer("fusion.alignment_min_fixes", c.fusion.fusion.alignment_min_fixes),
       number("fusion.alignment_min_extent_m", c.fusion.fusion.alignment_min_extent_m),
       number("fusion.alignment_min_cross_extent_m", c.fusion.fusion.alignment_min_cross_extent_m),
-      number("fusion.vio_drift_fraction", c.fusion.fusion.vio_drift_fraction),
-      number("fusion.vio_sigma_floor_m", c.fusion.fusion.vio_sigma_floor_m),
+      numberOrAuto("fusion.vio_drift_fraction", c.fusion.vio_drift_fraction),
+      numberOrAuto("fusion.vio_sigma_floor_m", c.fusion.vio_sigma_floor_m),
       number("fusion.vio_rot_drift_rad_per_m", c.fusion.fusion.vio_rot_drift_rad_per_m),
-      number("fusion.vio_rot_floor_rad", c.fusion.fusion.vio_rot_floor_rad),
+      numberOrAuto("fusion.vio_rot_floor_rad", c.fusion.vio_rot_floor_rad),
       number("fusion.tilt_sigma_deg", c.fusion.fusion.tilt_sigma_deg),
       integer("fusion.window_nodes", c.fusion.fusion.window_nodes),
       number("fusion.huber_sigmas", c.fusion.fusion.huber_sigmas),

@@ -19,7 +19,7 @@ int runMergeCommand(const MergeCliOptions& o) {
   const auto config = o.config.load();
   request.config = config.merge;
   request.loops = config.loops;
-  request.fusion = config.fusion.fusion;
+  request.fusion = config.fusion.fusionFor(std::nullopt);  // the runs' VIO modes may differ
   if (o.tile_size_m) request.config.tile_size_m = *o.tile_size_m;
   fleet::runMerge(request);
   return 0;

@@ -105,6 +105,12 @@ void writeReport(RunState& s) {
   report["run_wall_s"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - s.started).count();
   report["stage_wall_s"] = s.stage_wall_s;
+  // The VIO noise model the fusion's graphs and the loop search used (config.yaml says auto
+  // where the VIO mode chose it).
+  report["vio_noise"] = {{"drift_fraction", s.fusion.vio_drift_fraction},
+                         {"sigma_floor_m", s.fusion.vio_sigma_floor_m},
+                         {"rot_drift_rad_per_m", s.fusion.vio_rot_drift_rad_per_m},
+                         {"rot_floor_rad", s.fusion.vio_rot_floor_rad}};
   report["sources"] = io::sourcesJson(
       {s.request.dataset, s.request.format, s.request.calib_files, s.request.gnss_file},
       s.dataset.format);

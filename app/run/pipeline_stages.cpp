@@ -40,6 +40,7 @@ void runVioStage(RunState& s) {
   const io::Dataset& ds = s.dataset;
   s.estimator = s.config.vio.estimator;
   s.estimator.mode = chooseVioMode(s.config.vio.mode, ds);
+  s.fusion = s.config.fusion.fusionFor(s.estimator.mode);
   const bool dataset_noise = ds.imu_noise && s.config.imu.prefer_dataset_noise;
   s.estimator.imu_noise = dataset_noise ? *ds.imu_noise : s.config.imu.noise;
   s.estimator.validate();
@@ -92,8 +93,8 @@ void runGnssStage(RunState& s) {
   if (!fuse) return;
   const fusion::FusionMode mode =
       gnss == "kf" ? fusion::FusionMode::kKf : fusion::FusionMode::kGraph;
-  s.gnss = fuseGnss(s.dataset, s.vio.trajectory, mode, s.config.fusion.fusion,
-                    s.config.fusion.originLla(), odometry::usesImu(s.estimator.mode));
+  s.gnss = fuseGnss(s.dataset, s.vio.trajectory, mode, s.fusion, s.config.fusion.originLla(),
+                    odometry::usesImu(s.estimator.mode));
   if (s.gnss && !s.gnss->fused.empty()) {
     s.final_trajectory = s.gnss->fused;
     s.georeferenced = true;
@@ -103,9 +104,8 @@ void runGnssStage(RunState& s) {
 void runLoopStage(RunState& s) {
   if (!s.loop_recorder || s.loop_recorder->empty()) return;
   try {
-    s.loops =
-        closeLoops(*s.loop_recorder, s.vio.trajectory, s.gnss ? &*s.gnss : nullptr,
-                   odometry::usesImu(s.estimator.mode), s.config.loops, s.config.fusion.fusion);
+    s.loops = closeLoops(*s.loop_recorder, s.vio.trajectory, s.gnss ? &*s.gnss : nullptr,
+                         odometry::usesImu(s.estimator.mode), s.config.loops, s.fusion);
   } catch (const std::exception& e) {
     // A bug or an odd drive inside loop closure must not cost the user the run.
     spdlog::warn("loop closure failed ({}): the run goes on without it", e.what());
@@ -113,9 +113,8 @@ void runLoopStage(RunState& s) {
   }
   if (s.config.loops.save_keyframes && s.loops && s.gnss) {
     const Trajectory& final_enu = s.loops->trajectory.empty() ? s.gnss->fused : s.loops->trajectory;
-    const auto db =
-        placeDatabase(*s.loop_recorder, s.vio.trajectory, final_enu, *s.gnss, &*s.loops,
-                      odometry::usesImu(s.estimator.mode), s.config.loops, s.config.fusion.fusion);
+    const auto db = placeDatabase(*s.loop_recorder, s.vio.trajectory, final_enu, *s.gnss, &*s.loops,
+                                  odometry::usesImu(s.estimator.mode), s.config.loops, s.fusion);
     if (db) io::writePlaceDatabase(s.request.out / "keyframes.bin", *db);
   }
   s.loop_recorder.reset();  // the features are no longer needed: free them before the map

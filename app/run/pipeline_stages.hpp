@@ -28,6 +28,7 @@ struct RunState {
   io::Dataset dataset;
   nlohmann::json gnss_noise;  // report.json's record of the degradation, null for none
   odometry::EstimatorConfig estimator;
+  fusion::FusionConfig fusion;   // config.fusion with the VIO noise of the run's VIO mode
   std::string imu_noise_source;  // "dataset" | "config"; empty without an IMU
   std::optional<MapRecorder> map_recorder;
   std::optional<LoopRecorder> loop_recorder;

@@ -1,6 +1,8 @@
 #include "run/run_config.hpp"
 
+#include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "odometry/error.hpp"
 
@@ -19,6 +21,25 @@ std::optional<fusion::Lla> FusionAppConfig::originLla() const {
   return lla;
 }
 
+// The VIO's relative-motion noise in the fusion's graphs by VIO mode. Stereo+IMU: the medians
+// of its relative error (SE(3), 3-D) at 10 m and 100 m over the 15 drives of the style matrix,
+// read as a random walk over keyframe steps of about 0.8 m: 0.2 % + 1 cm and 2e-4 rad per step
+// (KITTI-00 SPP graph 0.913 -> 0.843 m; README "Loop closure"). Mono+IMU (scale drift) and
+// stereo alone (rotation drift, no tilt from gravity) measured worse with it and keep the
+// library's 0.4 % + 2 cm and 5e-4 rad.
+fusion::FusionConfig FusionAppConfig::fusionFor(std::optional<odometry::VioMode> mode) const {
+  fusion::FusionConfig c = fusion;
+  if (mode == odometry::VioMode::kStereoImu) {
+    c.vio_drift_fraction = 0.002;
+    c.vio_sigma_floor_m = 0.01;
+    c.vio_rot_floor_rad = 2e-4;
+  }
+  if (vio_drift_fraction > 0.0) c.vio_drift_fraction = vio_drift_fraction;
+  if (vio_sigma_floor_m > 0.0) c.vio_sigma_floor_m = vio_sigma_floor_m;
+  if (vio_rot_floor_rad > 0.0) c.vio_rot_floor_rad = vio_rot_floor_rad;
+  return c;
+}
+
 fusion::InsConfig FusionAppConfig::insConfig(const ImuNoise& imu_noise) const {
   fusion::InsConfig c = ins;
   c.lever_arm_b = fusion.lever_arm_b;
@@ -32,6 +53,15 @@ fusion::InsConfig FusionAppConfig::insConfig(const ImuNoise& imu_noise) const {
 
 void FusionAppConfig::validate() const {
   (void)originLla();
+  const auto autoOrPositive = [](double value, const char* key) {
+    if (!(value >= 0.0) || !std::isfinite(value)) {
+      throw InvalidInput(std::string("config: ") + key +
+                         " must be auto or a positive number (got " + std::to_string(value) + ")");
+    }
+  };
+  autoOrPositive(vio_drift_fraction, "fusion.vio_drift_fraction");
+  autoOrPositive(vio_sigma_floor_m, "fusion.vio_sigma_floor_m");
+  autoOrPositive(vio_rot_floor_rad, "fusion.vio_rot_floor_rad");
   fusion.validate();
   insConfig(ImuNoise{}).validate();
 }

@@ -36,10 +36,19 @@ struct FusionAppConfig {
   // Origin of the local ENU frame: "first-fix", or "lat,lon,h" (deg, deg, ellipsoidal m).
   std::string origin = "first-fix";
   fusion::FusionConfig fusion;
+  // The graphs' VIO relative-motion noise (fusion.vio_drift_fraction, vio_sigma_floor_m,
+  // vio_rot_floor_rad; fusion.vio_rot_drift_rad_per_m is one value for every mode): 0 = auto, the
+  // figures measured for the run's VIO mode (fusionFor); a value set overrides them.
+  double vio_drift_fraction = 0.0;
+  double vio_sigma_floor_m = 0.0;
+  double vio_rot_floor_rad = 0.0;
   // GNSS/INS without a camera (fusion.ins.*); its lever arm, time offset, gate, rejections and
   // outage length are fusion.*'s, and its IMU noise imu.*'s: see insConfig().
   fusion::InsConfig ins;
 
+  // `fusion` with the VIO noise of `mode` (nullopt: not known, as in gvio merge: the model of
+  // the modes that drift most) where the three fields above say auto.
+  [[nodiscard]] fusion::FusionConfig fusionFor(std::optional<odometry::VioMode> mode) const;
   // `ins` with the shared fusion.* values and `imu_noise` filled in.
   [[nodiscard]] fusion::InsConfig insConfig(const ImuNoise& imu_noise) const;
   // The origin as given, nullopt for first-fix; throws InvalidInput for malformed text.

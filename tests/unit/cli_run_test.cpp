@@ -271,6 +271,10 @@ TEST_F(CliRunEndToEnd, ReportHasTheContractFields) {
   EXPECT_EQ(r["gnss"]["registered"], true);
   EXPECT_TRUE(r["gnss"]["ms_per_fix"]["mean"].is_number());
   EXPECT_TRUE(r["outages"].is_array());
+  // fusion.vio_* auto with stereo+IMU: the model measured for that mode.
+  EXPECT_DOUBLE_EQ(r["vio_noise"].value("drift_fraction", -1.0), 0.002);
+  EXPECT_DOUBLE_EQ(r["vio_noise"].value("sigma_floor_m", -1.0), 0.01);
+  EXPECT_DOUBLE_EQ(r["vio_noise"].value("rot_floor_rad", -1.0), 2e-4);
   ASSERT_TRUE(r["events"].is_array());
   bool initialized = false;
   for (const auto& e : r["events"]) {

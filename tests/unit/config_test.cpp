@@ -171,6 +171,49 @@ TEST(Config, SolverIterationsAreAutoOrAPositiveInteger) {
   EXPECT_THAT(errorOf({std::nullopt, {"vio.max_iterations=101"}}), HasSubstr("max_iterations"));
 }
 
+// fusion.vio_drift_fraction, vio_sigma_floor_m, vio_rot_floor_rad: "auto" takes the model
+// measured for the run's VIO mode (tighter for stereo+IMU); a value set wins in every mode.
+TEST(Config, FusionVioNoiseIsAutoByModeOrAsSet) {
+  AppConfig c = loadConfig({std::nullopt, {}});
+  EXPECT_THAT(dumpConfigYaml(c), HasSubstr("vio_drift_fraction: auto"));
+  EXPECT_THAT(dumpConfigYaml(c), HasSubstr("vio_rot_floor_rad: auto"));
+  const fusion::FusionConfig library;  // the library's defaults: the model of the other modes
+  const fusion::FusionConfig stereo_imu = c.fusion.fusionFor(odometry::VioMode::kStereoImu);
+  EXPECT_DOUBLE_EQ(stereo_imu.vio_drift_fraction, 0.002);
+  EXPECT_DOUBLE_EQ(stereo_imu.vio_sigma_floor_m, 0.01);
+  EXPECT_DOUBLE_EQ(stereo_imu.vio_rot_floor_rad, 2e-4);
+  EXPECT_DOUBLE_EQ(stereo_imu.vio_rot_drift_rad_per_m, library.vio_rot_drift_rad_per_m);
+  for (const auto mode :
+       {std::optional(odometry::VioMode::kMonoImu), std::optional(odometry::VioMode::kStereo),
+        std::optional<odometry::VioMode>()}) {
+    const fusion::FusionConfig f = c.fusion.fusionFor(mode);
+    EXPECT_DOUBLE_EQ(f.vio_drift_fraction, library.vio_drift_fraction);
+    EXPECT_DOUBLE_EQ(f.vio_sigma_floor_m, library.vio_sigma_floor_m);
+    EXPECT_DOUBLE_EQ(f.vio_rot_floor_rad, library.vio_rot_floor_rad);
+  }
+  c = loadConfig(
+      {std::nullopt, {"fusion.vio_drift_fraction=0.003", "fusion.vio_rot_floor_rad=1e-3"}});
+  EXPECT_THAT(dumpConfigYaml(c), HasSubstr("vio_drift_fraction: 0.003"));
+  for (const auto mode : {odometry::VioMode::kStereoImu, odometry::VioMode::kMonoImu}) {
+    const fusion::FusionConfig f = c.fusion.fusionFor(mode);
+    EXPECT_DOUBLE_EQ(f.vio_drift_fraction, 0.003);
+    EXPECT_DOUBLE_EQ(f.vio_rot_floor_rad, 1e-3);
+  }
+  EXPECT_DOUBLE_EQ(c.fusion.fusionFor(odometry::VioMode::kStereoImu).vio_sigma_floor_m, 0.01);
+  // A dumped config read back gives the same values.
+  const test::TempDir dir("config_vio_noise");
+  test::writeText(dir.path() / "c.yaml", dumpConfigYaml(c));
+  const AppConfig back = loadConfig({dir.path() / "c.yaml", {}});
+  EXPECT_DOUBLE_EQ(back.fusion.vio_drift_fraction, 0.003);
+  EXPECT_DOUBLE_EQ(back.fusion.vio_sigma_floor_m, 0.0);
+  EXPECT_THAT(errorOf({std::nullopt, {"fusion.vio_sigma_floor_m=0"}}),
+              HasSubstr("expected auto or a positive number"));
+  EXPECT_THAT(errorOf({std::nullopt, {"fusion.vio_drift_fraction=-1"}}),
+              HasSubstr("bad value '-1' for fusion.vio_drift_fraction"));
+  EXPECT_THAT(errorOf({std::nullopt, {"fusion.vio_rot_floor_rad=nan"}}),
+              HasSubstr("fusion.vio_rot_floor_rad"));
+}
+
 TEST(Config, FoldedLandmarksAreDroppedWithTheImuUnlessSet) {
   AppConfig c = loadConfig({std::nullopt, {}});
   EXPECT_EQ(c.vio.estimator.folded_landmarks, odometry::FoldedLandmarks::kAuto);
