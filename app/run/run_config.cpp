@@ -1,8 +1,6 @@
 #include "run/run_config.hpp"
 
-#include <cmath>
 #include <cstdio>
-#include <string>
 
 #include "odometry/error.hpp"
 
@@ -34,9 +32,10 @@ fusion::FusionConfig FusionAppConfig::fusionFor(std::optional<odometry::VioMode>
     c.vio_sigma_floor_m = 0.01;
     c.vio_rot_floor_rad = 2e-4;
   }
-  if (vio_drift_fraction > 0.0) c.vio_drift_fraction = vio_drift_fraction;
-  if (vio_sigma_floor_m > 0.0) c.vio_sigma_floor_m = vio_sigma_floor_m;
-  if (vio_rot_floor_rad > 0.0) c.vio_rot_floor_rad = vio_rot_floor_rad;
+  // Anything but 0 (auto) is the user's, checked by FusionConfig::validate (validate() below).
+  if (vio_drift_fraction != 0.0) c.vio_drift_fraction = vio_drift_fraction;
+  if (vio_sigma_floor_m != 0.0) c.vio_sigma_floor_m = vio_sigma_floor_m;
+  if (vio_rot_floor_rad != 0.0) c.vio_rot_floor_rad = vio_rot_floor_rad;
   return c;
 }
 
@@ -53,16 +52,8 @@ fusion::InsConfig FusionAppConfig::insConfig(const ImuNoise& imu_noise) const {
 
 void FusionAppConfig::validate() const {
   (void)originLla();
-  const auto autoOrPositive = [](double value, const char* key) {
-    if (!(value >= 0.0) || !std::isfinite(value)) {
-      throw InvalidInput(std::string("config: ") + key +
-                         " must be auto or a positive number (got " + std::to_string(value) + ")");
-    }
-  };
-  autoOrPositive(vio_drift_fraction, "fusion.vio_drift_fraction");
-  autoOrPositive(vio_sigma_floor_m, "fusion.vio_sigma_floor_m");
-  autoOrPositive(vio_rot_floor_rad, "fusion.vio_rot_floor_rad");
   fusion.validate();
+  fusionFor(std::nullopt).validate();  // the VIO noise values set (the auto ones are fusion's)
   insConfig(ImuNoise{}).validate();
 }
 
