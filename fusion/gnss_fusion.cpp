@@ -110,7 +110,7 @@ struct GnssFusion::Impl {
       const Eigen::Isometry3d& T_ls) const;
   bool fuseGraph(const Pair& pair);
   void addNodePriors(GraphNode& node, bool first);
-  [[nodiscard]] double registrationHeadingSigmaRad(const std::vector<bool>& use) const;
+  void setRegistrationAngleSigmas(const std::vector<bool>& use);
   bool fuseKf(const Pair& pair);
   Eigen::Isometry3d fusedPose(std::int64_t t_ns, const Eigen::Isometry3d& T_w_b) const;
   void noteAccepted(std::int64_t t_ns);
@@ -126,7 +126,8 @@ struct GnssFusion::Impl {
   std::deque<GnssFix> pending;
   std::vector<Pair> alignment_pairs;
   std::optional<Eigen::Isometry3d> T_enu_w;
-  double registration_yaw_sigma_rad = 0.0;  // how well the registration's fixes fix the heading
+  double registration_yaw_sigma_rad = 0.0;   // how well the registration's fixes fix the heading
+  double registration_tilt_sigma_rad = 0.0;  // ... and the tilt (used without an IMU)
   GraphWindow graph;
   KfBaseline kf;
   std::int64_t kf_t_ns = 0;
@@ -231,15 +232,16 @@ std::optional<std::vector<bool>> GnssFusion::Impl::registrationPairs(
   return inliers;
 }
 
-// The heading's 1-sigma (rad) that a yaw + translation registration on the used pairs leaves:
-// twice the fixes' mean horizontal sigma across their horizontal span (a conservative bound:
+// The heading's and the tilt's 1-sigma (rad) that a registration on the used pairs leaves: twice
+// the fixes' mean horizontal (vertical) sigma across their horizontal span (a conservative bound:
 // fixes at both ends of a span L, each off by sigma, turn it by at most about 2 sigma / L).
-double GnssFusion::Impl::registrationHeadingSigmaRad(const std::vector<bool>& use) const {
-  double span = 0.0, sigma = 0.0;
+void GnssFusion::Impl::setRegistrationAngleSigmas(const std::vector<bool>& use) {
+  double span = 0.0, sigma_h = 0.0, sigma_v = 0.0;
   int n = 0;
   for (std::size_t i = 0; i < alignment_pairs.size(); ++i) {
     if (!use[i]) continue;
-    sigma += alignment_pairs[i].fix.sigma_h_m;
+    sigma_h += alignment_pairs[i].fix.sigma_h_m;
+    sigma_v += alignment_pairs[i].fix.sigma_v_m;
     ++n;
     for (std::size_t j = 0; j < i; ++j) {
       if (!use[j]) continue;
@@ -247,8 +249,9 @@ double GnssFusion::Impl::registrationHeadingSigmaRad(const std::vector<bool>& us
       span = std::max(span, std::hypot(d.x(), d.y()));
     }
   }
-  if (n == 0 || span <= 0.0) return kFreeRad;
-  return std::atan2(2.0 * sigma / n, span);
+  const bool none = n == 0 || span <= 0.0;
+  registration_yaw_sigma_rad = none ? kFreeRad : std::atan2(2.0 * sigma_h / n, span);
+  registration_tilt_sigma_rad = none ? kFreeRad : std::atan2(2.0 * sigma_v / n, span);
 }
 
 void GnssFusion::Impl::align(const Pair& pair) {
@@ -267,7 +270,7 @@ void GnssFusion::Impl::align(const Pair& pair) {
     T_enu_w = registration(use);
     if (!T_enu_w) return;
   }
-  registration_yaw_sigma_rad = registrationHeadingSigmaRad(use);
+  setRegistrationAngleSigmas(use);
   // Back-fill the poses seen so far with the registration, then start the chosen filter; the
   // pairs outside the consensus are rejected.
   stats.poses_before_alignment = static_cast<int>(vio.size());
@@ -329,14 +332,19 @@ bool GnssFusion::Impl::fuseGraph(const Pair& pair) {
 // at all for an antenna above the body), so the first node also keeps the registration's heading,
 // within what the registration's fixes say of it; later nodes get their heading through the VIO's
 // relative poses and the track of the fixes, as before.
+// Without an IMU nothing observes the tilt but the fixes, so the first node keeps the whole
+// rotation of the registration, which rests on all its fixes: left free, the window's first two
+// nodes tilt to fit two fixes' height noise over ~10 m (a 35 deg pitch and 52 m of online height
+// error on a simulated 60 s street drive, stereo alone, before the gate's reset).
 void GnssFusion::Impl::addNodePriors(GraphNode& node, bool first) {
   const double tilt_sigma = config.tiltSigmaRad();
-  if (tilt_sigma <= 0.0) return;  // no IMU: the VIO's world is not levelled
-  const Eigen::Vector3d g_b = node.T_w_b.rotation().transpose() * Eigen::Vector3d::UnitZ();
-  graph.addPrior(node, std::make_shared<TiltFactor>(g_b, tilt_sigma));
+  if (tilt_sigma > 0.0) {
+    const Eigen::Vector3d g_b = node.T_w_b.rotation().transpose() * Eigen::Vector3d::UnitZ();
+    graph.addPrior(node, std::make_shared<TiltFactor>(g_b, tilt_sigma));
+  }
   if (!first) return;
   odometry::PoseSigmas sigmas;
-  sigmas.tilt_rad = kFreeRad;  // the tilt factor's
+  sigmas.tilt_rad = tilt_sigma > 0.0 ? kFreeRad : registration_tilt_sigma_rad;  // the tilt factor's
   sigmas.yaw_rad = registration_yaw_sigma_rad;
   sigmas.position_m = kFreePositionM;  // the fix's
   graph.addPrior(node, std::make_shared<odometry::PosePriorFactor>(node.pose.data(), sigmas));
