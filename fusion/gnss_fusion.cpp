@@ -1,14 +1,12 @@
 #include "fusion/gnss_fusion.hpp"
 
-#include "fusion/alignment_consensus.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <numbers>
 
 #include "fusion/gnss_factors.hpp"
-#include "fusion/graph_window.hpp"
+#include "fusion/gnss_fusion_impl.hpp"
 #include "odometry/error.hpp"
 #include "odometry/prior_factor.hpp"
 
@@ -18,13 +16,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 // Chi-square, 6 degrees of freedom, 99.9 %: the KF's position + velocity innovation gate.
 constexpr double kKfGateChi2 = 22.46;
-// Solver iterations per fix in graph mode (the window is small and warm-started).
-constexpr int kGraphIterations = 5;
 // A fix without a usable previous one gets no velocity information (variance in (m/s)^2).
 constexpr double kNoVelocityVariance = 1e8;
-// Sigmas that leave a prior's component free.
-constexpr double kFreeRad = 10.0;
-constexpr double kFreePositionM = 1e4;
 
 }  // namespace
 
@@ -90,53 +83,6 @@ void FusionConfig::validate() const {
   smoother.validate();
 }
 
-struct GnssFusion::Impl {
-  struct Pair {
-    std::int64_t t_ns;
-    Eigen::Isometry3d T_w_b;
-    Eigen::Vector3d p_enu;
-    GnssFix fix;
-  };
-
-  Impl(const FusionConfig& c, const EnuFrame& e)
-      : config(c), enu(e), graph(c.window_nodes, c.huber_sigmas, kGraphIterations), kf(c.kf) {}
-
-  void processFix(const GnssFix& fix);
-  void align(const Pair& pair);
-  [[nodiscard]] bool residualsConsistent(const Eigen::Isometry3d& T_enu_w,
-                                         const std::vector<bool>& use) const;
-  [[nodiscard]] std::optional<Eigen::Isometry3d> registration(const std::vector<bool>& use) const;
-  [[nodiscard]] std::optional<std::vector<bool>> registrationPairs(
-      const Eigen::Isometry3d& T_ls) const;
-  bool fuseGraph(const Pair& pair);
-  void addNodePriors(GraphNode& node, bool first);
-  void setRegistrationAngleSigmas(const std::vector<bool>& use);
-  bool fuseKf(const Pair& pair);
-  Eigen::Isometry3d fusedPose(std::int64_t t_ns, const Eigen::Isometry3d& T_w_b) const;
-  void noteAccepted(std::int64_t t_ns);
-  void noteOutcome(const Pair& pair, bool used);
-  void noteGraphNode(const Pair& pair);
-  void smooth();
-
-  FusionConfig config;
-  EnuFrame enu;
-  Trajectory vio, fused, smoothed;
-  std::vector<PoseCovariance> smoothed_covariance;
-  std::vector<SmootherFix> graph_fixes;  // every fix the graph used, for the smoothing pass
-  std::deque<GnssFix> pending;
-  std::vector<Pair> alignment_pairs;
-  std::optional<Eigen::Isometry3d> T_enu_w;
-  double registration_yaw_sigma_rad = 0.0;   // how well the registration's fixes fix the heading
-  double registration_tilt_sigma_rad = 0.0;  // ... and the tilt (used without an IMU)
-  GraphWindow graph;
-  KfBaseline kf;
-  std::int64_t kf_t_ns = 0;
-  std::optional<Pair> previous_fix;  // KF: finite-difference GNSS velocity
-  int consecutive_rejections = 0;
-  std::optional<std::int64_t> last_accepted_ns;
-  FusionStats stats;
-};
-
 Eigen::Isometry3d GnssFusion::Impl::fusedPose(std::int64_t t_ns,
                                               const Eigen::Isometry3d& T_w_b) const {
   if (config.mode == FusionMode::kGraph && !graph.empty()) {
@@ -168,120 +114,6 @@ void GnssFusion::Impl::noteOutcome(const Pair& pair, bool used) {
   } else {
     ++stats.fixes_rejected;
   }
-}
-
-// The registration explains the fixes when the median squared residual, normalised by each fix's
-// sigma, stays within the gate (the median ignores the rare outlier). A chi-square(3) variable
-// has median 2.37; the gate (99.9 %) leaves room for the receiver's unmodelled bias.
-bool GnssFusion::Impl::residualsConsistent(const Eigen::Isometry3d& T,
-                                           const std::vector<bool>& use) const {
-  std::vector<double> chi2;
-  for (std::size_t i = 0; i < alignment_pairs.size(); ++i) {
-    if (!use[i]) continue;
-    const Pair& p = alignment_pairs[i];
-    const Eigen::Vector3d r = p.p_enu - T * (p.T_w_b * config.lever_arm_b);
-    const double var_h = p.fix.sigma_h_m * p.fix.sigma_h_m;
-    chi2.push_back(r.head<2>().squaredNorm() / var_h +
-                   r.z() * r.z() / (p.fix.sigma_v_m * p.fix.sigma_v_m));
-  }
-  if (chi2.empty()) return false;
-  const auto mid = chi2.begin() + static_cast<std::ptrdiff_t>(chi2.size() / 2);
-  std::nth_element(chi2.begin(), mid, chi2.end());
-  return *mid <= config.gate_chi2;
-}
-
-std::optional<Eigen::Isometry3d> GnssFusion::Impl::registration(
-    const std::vector<bool>& use) const {
-  std::vector<Eigen::Vector3d> p_w, p_enu;
-  for (std::size_t i = 0; i < alignment_pairs.size(); ++i) {
-    if (!use[i]) continue;
-    p_w.push_back(alignment_pairs[i].T_w_b * config.lever_arm_b);
-    p_enu.push_back(alignment_pairs[i].p_enu);
-  }
-  std::optional<Eigen::Isometry3d> T =
-      alignVioToEnu(p_w, p_enu, config.alignment, config.alignment_min_extent_m,
-                    config.alignment_min_cross_extent_m);
-  if (T && config.alignment == AlignmentDof::kRotationTranslation &&
-      !residualsConsistent(*T, use)) {
-    T.reset();  // e.g. a tilted start under the yaw-only stand-in: wait for more spread
-  }
-  return T;
-}
-
-// The pairs the registration rests on: all of them while the least-squares registration leaves
-// none outside the gate; else the largest consensus (fusion/alignment_consensus.hpp), and only
-// when it is a clear majority (two thirds) of at least alignment_min_fixes pairs, so that a
-// burst of outliers early in the drive cannot outvote the good fixes: then the registration
-// waits for more fixes.
-std::optional<std::vector<bool>> GnssFusion::Impl::registrationPairs(
-    const Eigen::Isometry3d& T_ls) const {
-  std::vector<AlignmentSample> samples;
-  bool all_within_gate = true;
-  for (const Pair& p : alignment_pairs) {
-    samples.push_back({p.T_w_b * config.lever_arm_b, p.p_enu, p.fix.sigma_h_m, p.fix.sigma_v_m});
-    all_within_gate = all_within_gate && registrationChi2(T_ls, samples.back(),
-                                                          config.gate_floor_m) <= config.gate_chi2;
-  }
-  if (all_within_gate) return std::vector<bool>(alignment_pairs.size(), true);
-  std::vector<bool> inliers = consensusInliers(samples, config.gate_chi2, config.gate_floor_m);
-  const auto count = static_cast<std::size_t>(std::count(inliers.begin(), inliers.end(), true));
-  if (count < static_cast<std::size_t>(config.alignment_min_fixes) ||
-      3 * count < 2 * alignment_pairs.size()) {
-    return std::nullopt;
-  }
-  return inliers;
-}
-
-// The heading's and the tilt's 1-sigma (rad) that a registration on the used pairs leaves: twice
-// the fixes' mean horizontal (vertical) sigma across their horizontal span (a conservative bound:
-// fixes at both ends of a span L, each off by sigma, turn it by at most about 2 sigma / L).
-void GnssFusion::Impl::setRegistrationAngleSigmas(const std::vector<bool>& use) {
-  double span = 0.0, sigma_h = 0.0, sigma_v = 0.0;
-  int n = 0;
-  for (std::size_t i = 0; i < alignment_pairs.size(); ++i) {
-    if (!use[i]) continue;
-    sigma_h += alignment_pairs[i].fix.sigma_h_m;
-    sigma_v += alignment_pairs[i].fix.sigma_v_m;
-    ++n;
-    for (std::size_t j = 0; j < i; ++j) {
-      if (!use[j]) continue;
-      const Eigen::Vector3d d = alignment_pairs[i].p_enu - alignment_pairs[j].p_enu;
-      span = std::max(span, std::hypot(d.x(), d.y()));
-    }
-  }
-  const bool none = n == 0 || span <= 0.0;
-  registration_yaw_sigma_rad = none ? kFreeRad : std::atan2(2.0 * sigma_h / n, span);
-  registration_tilt_sigma_rad = none ? kFreeRad : std::atan2(2.0 * sigma_v / n, span);
-}
-
-void GnssFusion::Impl::align(const Pair& pair) {
-  alignment_pairs.push_back(pair);
-  if (static_cast<int>(alignment_pairs.size()) < config.alignment_min_fixes) return;
-  std::vector<bool> use(alignment_pairs.size(), true);
-  T_enu_w = registration(use);
-  if (!T_enu_w) return;
-  const std::optional<std::vector<bool>> kept = registrationPairs(*T_enu_w);
-  if (!kept) {
-    T_enu_w.reset();
-    return;
-  }
-  if (*kept != use) {
-    use = *kept;
-    T_enu_w = registration(use);
-    if (!T_enu_w) return;
-  }
-  setRegistrationAngleSigmas(use);
-  // Back-fill the poses seen so far with the registration, then start the chosen filter; the
-  // pairs outside the consensus are rejected.
-  stats.poses_before_alignment = static_cast<int>(vio.size());
-  fused.t_ns = vio.t_ns;
-  fused.poses.clear();
-  for (const auto& T : vio.poses) fused.poses.push_back(*T_enu_w * T);
-  for (std::size_t i = 0; i < alignment_pairs.size(); ++i) {
-    const Pair& p = alignment_pairs[i];
-    noteOutcome(p, use[i] && (config.mode == FusionMode::kGraph ? fuseGraph(p) : fuseKf(p)));
-  }
-  alignment_pairs.clear();
 }
 
 bool GnssFusion::Impl::fuseGraph(const Pair& pair) {
