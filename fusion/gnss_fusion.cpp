@@ -176,7 +176,8 @@ void GnssFusion::Impl::addNodePriors(GraphNode& node, bool first) {
   }
   if (!first) return;
   odometry::PoseSigmas sigmas;
-  sigmas.tilt_rad = tilt_sigma > 0.0 ? kFreeRad : registration_tilt_sigma_rad;  // the tilt factor's
+  // With an IMU the tilt is the tilt factor's; without one, the registration's.
+  sigmas.tilt_rad = tilt_sigma > 0.0 ? kFreeRad : registration_tilt_sigma_rad;
   sigmas.yaw_rad = registration_yaw_sigma_rad;
   sigmas.position_m = kFreePositionM;  // the fix's
   graph.addPrior(node, std::make_shared<odometry::PosePriorFactor>(node.pose.data(), sigmas));
