@@ -232,6 +232,7 @@ SolveStats SlidingWindow::solve(bool use_imu) {
     add(timeOffsetPrior(), nullptr, {time_offset_s_.get()});
   }
   stats.time_offset_held = with_time_offset && timeOffsetUnobservable();
+  if (stats.time_offset_held) startTimeOffsetHold();
   if (stats.time_offset_held && problem.HasParameterBlock(time_offset_s_.get())) {
     problem.SetParameterBlockConstant(time_offset_s_.get());
   }
@@ -275,7 +276,25 @@ SolveStats SlidingWindow::solve(bool use_imu) {
   ceres::Solve(options, &problem, &summary);
   stats.iterations = static_cast<int>(summary.iterations.size());
   stats.converged = summary.termination_type == ceres::CONVERGENCE;
+  if (with_time_offset && !stats.time_offset_held) recordFreeTimeOffset();
   return stats;
+}
+
+void SlidingWindow::startTimeOffsetHold() {
+  if (free_time_offsets_s_.empty()) return;  // held already (or never free): stays where it is
+  std::vector<double> v(free_time_offsets_s_.begin(), free_time_offsets_s_.end());
+  // The lower median for an even count: a value one solve actually reached.
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>((v.size() - 1) / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  *time_offset_s_ = *mid;
+  free_time_offsets_s_.clear();
+}
+
+void SlidingWindow::recordFreeTimeOffset() {
+  free_time_offsets_s_.push_back(*time_offset_s_);
+  while (static_cast<int>(free_time_offsets_s_.size()) > config_.time_offset_hold_median_solves) {
+    free_time_offsets_s_.pop_front();
+  }
 }
 
 void SlidingWindow::marginalizeOldest(bool use_imu) {

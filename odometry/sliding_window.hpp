@@ -118,6 +118,7 @@ class SlidingWindow {
   // initialisation observed), else vio.time_offset_sigma_s.
   void setTimeOffsetS(double t_d_s, std::optional<double> sigma_s = std::nullopt) {
     *time_offset_s_ = t_d_s;
+    free_time_offsets_s_.clear();  // estimates of a window timed otherwise
     time_offset_prior_mean_s_ = t_d_s;
     time_offset_prior_sigma_s_ = sigma_s.value_or(config_.time_offset_sigma_s);
   }
@@ -132,6 +133,10 @@ class SlidingWindow {
   [[nodiscard]] bool estimatesTimeOffset(bool use_imu) const {
     return use_imu && config_.estimate_time_offset;
   }
+  // Where a hold starts, t_d moves to the median of the latest free solves' values; after a free
+  // solve, its value joins them.
+  void startTimeOffsetHold();
+  void recordFreeTimeOffset();
   // The prior on t_d (around its value when the window last started) while the marginalisation
   // prior does not hold t_d yet.
   [[nodiscard]] bool priorHoldsTimeOffset() const;
@@ -159,6 +164,9 @@ class SlidingWindow {
   std::unique_ptr<double> time_offset_s_ = std::make_unique<double>(0.0);
   double time_offset_prior_mean_s_ = 0.0;
   double time_offset_prior_sigma_s_;  // config_.time_offset_sigma_s unless set
+  // t_d after each of the latest free solves (at most time_offset_hold_median_solves, newest
+  // last), emptied when a hold starts: the hold keeps their median.
+  std::deque<double> free_time_offsets_s_;
 };
 
 }  // namespace gvio::odometry

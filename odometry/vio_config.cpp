@@ -103,6 +103,7 @@ void EstimatorConfig::validate() const {
           ">= 0");
   require(nonNegative(time_offset_min_force_change_mps2), "time_offset_min_force_change_mps2",
           ">= 0");
+  require(time_offset_hold_median_solves >= 1, "time_offset_hold_median_solves", ">= 1");
   require(positive(gyr_bias_prior_radps), "gyr_bias_prior_radps", "> 0");
   require(min_features_tracking >= 5, "min_features_tracking", ">= 5");
 }

@@ -315,6 +315,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("vio.time_offset_random_walk_s", e.time_offset_random_walk_s),
       number("vio.time_offset_min_rate_change_radps", e.time_offset_min_rate_change_radps),
       number("vio.time_offset_min_force_change_mps2", e.time_offset_min_force_change_mps2),
+      integer("vio.time_offset_hold_median_solves", e.time_offset_hold_median_solves),
       number("vio.gyr_bias_prior_radps", e.gyr_bias_prior_radps),
       integer("vio.tracker.max_features", e.tracker.max_features),
       number("vio.tracker.quality_level", e.tracker.quality_level),

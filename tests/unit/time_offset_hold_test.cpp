@@ -105,6 +105,9 @@ TEST(TimeOffsetHold, NegativeThresholdsAreRefused) {
   config = EstimatorConfig{};
   config.time_offset_min_force_change_mps2 = std::nan("");
   EXPECT_THROW(config.validate(), InvalidInput);
+  config = EstimatorConfig{};
+  config.time_offset_hold_median_solves = 0;  // a hold needs at least one free solve's value
+  EXPECT_THROW(config.validate(), InvalidInput);
 }
 
 // The marginalisation folds a held t_d's residuals in through FixedBlockCost: the same residuals
