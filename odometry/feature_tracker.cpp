@@ -166,6 +166,7 @@ void TrackerConfig::validate() const {
   requireInt(klt_window_px >= 3 && klt_window_px % 2 == 1, "klt_window_px", klt_window_px,
              "odd and >= 3");
   requireInt(klt_levels >= 0 && klt_levels <= 8, "klt_levels", klt_levels, "in [0, 8]");
+  requireInt(detect_level >= 0 && detect_level <= 3, "detect_level", detect_level, "in [0, 3]");
   requireInt(klt_iterations >= 1, "klt_iterations", klt_iterations, ">= 1");
   requireInt(
       klt_refine_window_px == 0 || (klt_refine_window_px >= 3 && klt_refine_window_px % 2 == 1 &&
@@ -366,8 +367,14 @@ void FeatureTracker::thinOutAndMask(const cv::Size& size) {
 // megabyte-sized response images anew on every call, which cost more than the detection itself.
 std::vector<cv::Point2f> FeatureTracker::shiTomasiCorners(const cv::Mat& image) {
   cv::cornerMinEigenVal(image, response_, kShiTomasiBlock, kShiTomasiAperture);
+  const int scale = 1 << config_.detect_level;
+  const cv::Mat* mask = &mask_;
+  if (scale > 1) {
+    cv::resize(mask_, detect_mask_, image.size(), 0.0, 0.0, cv::INTER_NEAREST);
+    mask = &detect_mask_;
+  }
   double best = 0.0;
-  cv::minMaxLoc(response_, nullptr, &best, nullptr, nullptr, mask_);
+  cv::minMaxLoc(response_, nullptr, &best, nullptr, nullptr, *mask);
   const auto threshold =
       static_cast<float>(std::max(config_.quality_level * best, kMinCornerResponse));
   cv::dilate(response_, local_max_, cv::Mat());
@@ -375,7 +382,7 @@ std::vector<cv::Point2f> FeatureTracker::shiTomasiCorners(const cv::Mat& image) 
   for (int y = 1; y + 1 < image.rows; ++y) {
     const auto* r = response_.ptr<float>(y);
     const auto* m = local_max_.ptr<float>(y);
-    const auto* allowed = mask_.ptr<std::uint8_t>(y);
+    const auto* allowed = mask->ptr<std::uint8_t>(y);
     for (int x = 1; x + 1 < image.cols; ++x) {
       if (r[x] >= threshold && r[x] == m[x] && allowed[x] != 0)
         candidates.emplace_back(r[x], y * image.cols + x);
@@ -384,13 +391,38 @@ std::vector<cv::Point2f> FeatureTracker::shiTomasiCorners(const cv::Mat& image) 
   std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
     return a.first != b.first ? a.first > b.first : a.second < b.second;
   });
+  // pyrDown's pixel (x, y) is centred on (2x, 2y) of the level below.
   std::vector<cv::Point2f> corners(candidates.size());
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     const int index = candidates[i].second;
-    corners[i] =
-        cv::Point2f(static_cast<float>(index % image.cols), static_cast<float>(index / image.cols));
+    corners[i] = cv::Point2f(static_cast<float>(scale * (index % image.cols)),
+                             static_cast<float>(scale * (index / image.cols)));
   }
   return corners;
+}
+
+// A corner found at detect_level, moved to the strongest full-resolution response within 2^level
+// pixels of where that level put it.
+cv::Point2f FeatureTracker::refinedCorner(const cv::Mat& left, const cv::Point& pixel) {
+  const int r = 1 << config_.detect_level;
+  const cv::Rect around =
+      cv::Rect(pixel.x - r, pixel.y - r, 2 * r + 1, 2 * r + 1) & cv::Rect(cv::Point(), left.size());
+  // An ROI: the filters read the image around it, so the values are the full image's.
+  cv::cornerMinEigenVal(left(around), refine_response_, kShiTomasiBlock, kShiTomasiAperture);
+  cv::Point best;
+  cv::minMaxLoc(refine_response_, nullptr, nullptr, nullptr, &best);
+  return {static_cast<float>(around.x + best.x), static_cast<float>(around.y + best.y)};
+}
+
+const cv::Mat& FeatureTracker::detectionImage(const cv::Mat& left) {
+  const int level = config_.detect_level;
+  if (level == 0) return left;
+  // buildOpticalFlowPyramid with derivatives: image, derivatives, image, ... per level.
+  const auto at = static_cast<std::size_t>(2 * level);
+  if (at < left_pyr_.size()) return left_pyr_[at];
+  cv::pyrDown(left, detect_image_);
+  for (int l = 1; l < level; ++l) cv::pyrDown(detect_image_, detect_image_);
+  return detect_image_;
 }
 
 // New corners, strongest first, where mask_ allows and their grid cell holds fewer than
@@ -407,17 +439,19 @@ void FeatureTracker::detectNew(const cv::Mat& left, TrackerStats& stats) {
   std::vector<int> count(static_cast<std::size_t>(cells), 0);
   for (const Track& t : tracks_) ++count[cellOf(t.px)];
   int added = 0;
-  for (const cv::Point2f& p : shiTomasiCorners(left)) {
+  for (const cv::Point2f& p : shiTomasiCorners(detectionImage(left))) {
     if (added == need) break;
     int& n = count[cellOf(p)];
     const cv::Point pixel(cvRound(p.x), cvRound(p.y));
     if (n >= cap || !inside(p, left.size()) || mask_.at<std::uint8_t>(pixel) == 0) continue;
-    cv::circle(mask_, pixel, config_.min_distance_px, cv::Scalar(0), cv::FILLED);
+    const cv::Point2f at = config_.detect_level > 0 ? refinedCorner(left, pixel) : p;
+    cv::circle(mask_, cv::Point(cvRound(at.x), cvRound(at.y)), config_.min_distance_px,
+               cv::Scalar(0), cv::FILLED);
     ++n;
     ++added;
     Track t;
     t.id = next_id_++;
-    t.px = p;
+    t.px = at;
     tracks_.push_back(t);
   }
   stats.new_features = added;

@@ -429,6 +429,8 @@ TEST(FeatureTrackerConfig, BadValuesNameTheField) {
       {"stereo_max_vertical_px", [](TrackerConfig& c) { c.stereo_max_vertical_px = -1.0; }},
       {"klt_predict_min_px", [](TrackerConfig& c) { c.klt_predict_min_px = -1.0; }},
       {"klt_predict_min_px", [](TrackerConfig& c) { c.klt_predict_min_px = std::nan(""); }},
+      {"detect_level", [](TrackerConfig& c) { c.detect_level = -1; }},
+      {"detect_level", [](TrackerConfig& c) { c.detect_level = 4; }},
   };
   for (const auto& [field, spoil] : cases) {
     TrackerConfig c;
@@ -620,6 +622,50 @@ TEST(FeatureTrackerImages, TinyImagesWork) {
   for (const Feature& f : second.features) {
     if (f.has_right) {
       EXPECT_NEAR((f.px_right - f.px_left).norm(), 0.0, 0.1);
+    }
+  }
+}
+
+// Corners found on the half-resolution level are placed on the full-resolution image's corners:
+// light squares on grey, slightly blurred, whose 4 x 30 corners are known. The Shi-Tomasi
+// response (3 x 3 blocks of 3 x 3 Sobel derivatives) peaks 1.5 px inside a square's outline on
+// both axes, where the full-resolution detection puts all 120 (measured). Without the pyramid to
+// take the level from (klt_levels 0) the tracker halves the image itself. (Level 2 placed 88
+// of 120 there, the others up to 14 px off: a square's corners are 5 px apart at 1/4 scale.)
+TEST(FeatureTrackerDetection, CornersFromACoarserLevelLieOnTheImagesCorners) {
+  cv::Mat img(360, 720, CV_8UC1, cv::Scalar(60));
+  std::vector<cv::Point2f> truth;
+  for (int row = 0; row < 5; ++row) {
+    for (int col = 0; col < 6; ++col) {
+      const int x0 = 40 + 110 * col + 7 * row, y0 = 30 + 65 * row + 3 * col;
+      cv::rectangle(img, cv::Rect(x0, y0, 41, 29), cv::Scalar(200), cv::FILLED);
+      for (const float dx : {1.0F, 39.0F}) {
+        for (const float dy : {1.0F, 27.0F}) truth.emplace_back(x0 + dx, y0 + dy);
+      }
+    }
+  }
+  cv::GaussianBlur(img, img, cv::Size(3, 3), 0.7);
+  for (const int klt_levels : {3, 0}) {
+    for (const int level : {0, 1}) {
+      TrackerConfig c;
+      c.stereo = false;
+      c.max_features = 200;
+      c.min_distance_px = 10;
+      c.klt_levels = klt_levels;
+      c.detect_level = level;
+      FeatureTracker tracker{c};
+      const TrackedFrame frame = tracker.track(0, img, cv::Mat());
+      int on_corner = 0;
+      for (const Feature& f : frame.features) {
+        double nearest = std::numeric_limits<double>::infinity();
+        for (const cv::Point2f& t : truth) {
+          nearest = std::min(nearest, std::hypot(f.px_left.x() - t.x, f.px_left.y() - t.y));
+        }
+        on_corner += nearest <= 1.0 ? 1 : 0;
+      }
+      SCOPED_TRACE(fmt::format("klt_levels {}, detect_level {}", klt_levels, level));
+      EXPECT_GE(on_corner, 110);  // of 120
+      EXPECT_EQ(on_corner, static_cast<int>(frame.features.size()));
     }
   }
 }
