@@ -659,7 +659,8 @@ TEST(FeatureTrackerDetection, CornersFromACoarserLevelLieOnTheImagesCorners) {
       for (const Feature& f : frame.features) {
         double nearest = std::numeric_limits<double>::infinity();
         for (const cv::Point2f& t : truth) {
-          nearest = std::min(nearest, std::hypot(f.px_left.x() - t.x, f.px_left.y() - t.y));
+          nearest = std::min(nearest, std::hypot(f.px_left.x() - static_cast<double>(t.x),
+                                                 f.px_left.y() - static_cast<double>(t.y)));
         }
         on_corner += nearest <= 1.0 ? 1 : 0;
       }
