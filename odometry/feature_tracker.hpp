@@ -22,9 +22,9 @@ struct TrackerConfig {
   // each corner then moved to the strongest full-resolution response within 2^L px. The response
   // over the whole image is the front end's largest single cost (5.6 of 16.3 ms per KITTI frame
   // on one core); level 1 takes a quarter of it. Not the default: stereo+IMU gained (style matrix
-  // geometric mean 0.0403 -> 0.0335 %, KITTI-00 1.105 -> 0.921 m), stereo alone and mono+IMU
-  // lost, and on the slanted-plane test one of its corners gets a stereo match 8 px off that
-  // the checks pass (docs/vio_matrix.md, "Corners from the half-resolution level").
+  // geometric mean 0.0403 -> 0.0335 %, KITTI-00 1.105 -> 0.921 m) and mono+IMU a little, stereo
+  // alone lost, and on the slanted-plane test one of its corners gets a stereo match 8 px off
+  // that the checks pass (docs/vio_matrix.md, "Corners from the half-resolution level").
   int detect_level = 0;
   int klt_window_px = 21;  // odd side of the KLT window
   int klt_levels = 3;      // pyramid levels above the full-resolution image
