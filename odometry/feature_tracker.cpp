@@ -44,7 +44,41 @@ constexpr int kShiTomasiAperture = 3;
 // track whose true match lies far away cannot "come back" through the coarse levels.
 constexpr int kReverseLevels = 1;
 
+// Half side of the patches whose ZNCC checks a stereo match (11 x 11, the size that separated
+// the wrong matches from the correct ones in docs/vio_matrix.md).
+constexpr int kZnccHalfPx = 5;
+
 using Clock = std::chrono::steady_clock;
+
+// Zero-mean normalised cross-correlation of the (2 half + 1)^2 patches of `a` around `pa` and of
+// `b` around `pb`, sampled bilinearly (cv::getRectSubPix, border replicated); -1 when either
+// patch is uniform (no correlation to speak of: a match on a flat patch is no match).
+double patchZncc(const cv::Mat& a, cv::Point2f pa, const cv::Mat& b, cv::Point2f pb, int half,
+                 cv::Mat& patch_a, cv::Mat& patch_b) {
+  const cv::Size size(2 * half + 1, 2 * half + 1);
+  cv::getRectSubPix(a, size, pa, patch_a, CV_32F);
+  cv::getRectSubPix(b, size, pb, patch_b, CV_32F);
+  const double n = static_cast<double>(size.area());
+  const double mean_a = cv::sum(patch_a)[0] / n;
+  const double mean_b = cv::sum(patch_b)[0] / n;
+  double ab = 0.0, aa = 0.0, bb = 0.0;
+  for (int y = 0; y < size.height; ++y) {
+    const float* ra = patch_a.ptr<float>(y);
+    const float* rb = patch_b.ptr<float>(y);
+    for (int x = 0; x < size.width; ++x) {
+      const double da = static_cast<double>(ra[x]) - mean_a;
+      const double db = static_cast<double>(rb[x]) - mean_b;
+      ab += da * db;
+      aa += da * da;
+      bb += db * db;
+    }
+  }
+  // Below a tenth of a grey level's variance per pixel a patch is flat (sensor noise of 8-bit
+  // images is about 1 DN).
+  constexpr double kFlatVariance = 0.01;
+  if (aa < kFlatVariance * n || bb < kFlatVariance * n) return -1.0;
+  return ab / std::sqrt(aa * bb);
+}
 
 // The upper median of a non-empty set (one of its values, never an average of two); reorders it.
 float upperMedian(std::vector<float>& values) {
@@ -175,6 +209,10 @@ void TrackerConfig::validate() const {
   requirePositive("fb_threshold_px", fb_threshold_px);
   requirePositive("ransac_threshold_px", ransac_threshold_px);
   requirePositive("stereo_max_vertical_px", stereo_max_vertical_px);
+  if (!(stereo_min_zncc >= -1.0 && stereo_min_zncc <= 1.0)) {
+    throw InvalidInput("config: tracker.stereo_min_zncc must be in [-1, 1] (got " +
+                       std::to_string(stereo_min_zncc) + ")");
+  }
   if (!(klt_predict_min_px >= 0.0)) {
     throw InvalidInput("config: tracker.klt_predict_min_px must be >= 0 (got " +
                        std::to_string(klt_predict_min_px) + ")");
@@ -461,6 +499,13 @@ void FeatureTracker::detectNew(const cv::Mat& left, TrackerStats& stats) {
 // rectification offset, the frame's median), left of the left position. KLT starts from
 // the previous frame's disparity when the feature had one (close points sit far beyond the
 // pyramid's reach from a zero guess), else from the same position.
+bool FeatureTracker::similarPatches(const cv::Point2f& left_px, const cv::Point2f& right_px) {
+  if (config_.stereo_min_zncc <= -1.0) return true;
+  // Level 0 of a pyramid built with derivatives is its first entry (the image itself).
+  return patchZncc(left_pyr_[0], left_px, right_pyr_[0], right_px, kZnccHalfPx, zncc_left_,
+                   zncc_right_) >= config_.stereo_min_zncc;
+}
+
 std::vector<Feature> FeatureTracker::matchStereo(TrackerStats& stats) {
   std::vector<Feature> features;
   features.reserve(tracks_.size());
@@ -482,8 +527,10 @@ std::vector<Feature> FeatureTracker::matchStereo(TrackerStats& stats) {
     Track& t = tracks_[i];
     const cv::Point2f& l = left_px[i];
     const cv::Point2f& r = right_px[i];
-    const bool match = candidate[i] && std::abs(r.y - l.y - row_offset) <=
-                                           static_cast<float>(config_.stereo_max_vertical_px);
+    const bool match =
+        candidate[i] &&
+        std::abs(r.y - l.y - row_offset) <= static_cast<float>(config_.stereo_max_vertical_px) &&
+        similarPatches(l, r);
     Eigen::Vector2d velocity_right = toEigen(t.velocity_pxps);
     if (match && t.has_disparity && t.length > 1 && dt_s_ > 0.0) {
       const double step = static_cast<double>(l.x - r.x - t.disparity) / dt_s_;
