@@ -201,6 +201,10 @@ void TrackerConfig::validate() const {
              "odd and >= 3");
   requireInt(klt_levels >= 0 && klt_levels <= 8, "klt_levels", klt_levels, "in [0, 8]");
   requireInt(detect_level >= 0 && detect_level <= 3, "detect_level", detect_level, "in [0, 3]");
+  if (!(min_eigen_ratio >= 0.0 && min_eigen_ratio <= 1.0)) {
+    throw InvalidInput("config: tracker.min_eigen_ratio must be in [0, 1] (got " +
+                       std::to_string(min_eigen_ratio) + ")");
+  }
   requireInt(klt_iterations >= 1, "klt_iterations", klt_iterations, ">= 1");
   requireInt(
       klt_refine_window_px == 0 || (klt_refine_window_px >= 3 && klt_refine_window_px % 2 == 1 &&
@@ -452,6 +456,34 @@ cv::Point2f FeatureTracker::refinedCorner(const cv::Mat& left, const cv::Point& 
   return {static_cast<float>(around.x + best.x), static_cast<float>(around.y + best.y)};
 }
 
+bool FeatureTracker::notOnAnEdge(const cv::Mat& left, const cv::Point2f& corner) {
+  if (config_.min_eigen_ratio <= 0.0) return true;
+  // The gradients of a 9 x 9 ROI (its filters read the image around it), summed over the 7 x 7
+  // inside: the covariance [a b; b c] whose eigenvalues KLT's conditioning is (Shi and Tomasi
+  // 1994).
+  constexpr int kHalf = 3;
+  const cv::Point c(cvRound(corner.x), cvRound(corner.y));
+  const cv::Rect roi = cv::Rect(c.x - kHalf - 1, c.y - kHalf - 1, 2 * kHalf + 3, 2 * kHalf + 3) &
+                       cv::Rect(cv::Point(), left.size());
+  cv::Sobel(left(roi), edge_gx_, CV_32F, 1, 0, 3);
+  cv::Sobel(left(roi), edge_gy_, CV_32F, 0, 1, 3);
+  double a = 0.0, b = 0.0, d = 0.0;
+  for (int y = 1; y + 1 < roi.height; ++y) {
+    const float* gx = edge_gx_.ptr<float>(y);
+    const float* gy = edge_gy_.ptr<float>(y);
+    for (int x = 1; x + 1 < roi.width; ++x) {
+      const double u = static_cast<double>(gx[x]), v = static_cast<double>(gy[x]);
+      a += u * u;
+      b += u * v;
+      d += v * v;
+    }
+  }
+  const double half_trace = (a + d) / 2.0;
+  const double spread = std::sqrt(std::max(0.0, half_trace * half_trace - (a * d - b * b)));
+  const double larger = half_trace + spread, smaller = half_trace - spread;
+  return larger > 0.0 && smaller / larger >= config_.min_eigen_ratio;
+}
+
 const cv::Mat& FeatureTracker::detectionImage(const cv::Mat& left) {
   const int level = config_.detect_level;
   if (level == 0) return left;
@@ -483,6 +515,7 @@ void FeatureTracker::detectNew(const cv::Mat& left, TrackerStats& stats) {
     const cv::Point pixel(cvRound(p.x), cvRound(p.y));
     if (n >= cap || !inside(p, left.size()) || mask_.at<std::uint8_t>(pixel) == 0) continue;
     const cv::Point2f at = config_.detect_level > 0 ? refinedCorner(left, pixel) : p;
+    if (!notOnAnEdge(left, at)) continue;
     cv::circle(mask_, cv::Point(cvRound(at.x), cvRound(at.y)), config_.min_distance_px,
                cv::Scalar(0), cv::FILLED);
     ++n;

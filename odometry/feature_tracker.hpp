@@ -26,6 +26,14 @@ struct TrackerConfig {
   // alone lost, and on the slanted-plane test one of its corners gets a stereo match 8 px off
   // that the checks pass (docs/vio_matrix.md, "Corners from the half-resolution level").
   int detect_level = 0;
+  // A new corner is dropped when the smaller eigenvalue of its gradient covariance over a 7 x 7
+  // window (the full-resolution KLT pass's) is below this fraction of the larger one (0: no
+  // check). Shi-Tomasi asks only for a large smaller eigenvalue, relative to the frame's best
+  // corner; where the frame has few corners (sparse texture: lane markings and wall edges) a
+  // point on a strong edge passes on its noise, and KLT slides along the edge (the aperture
+  // problem). Under forward motion a lane marking points at the focus of expansion, along the
+  // epipolar lines, so the fundamental-matrix RANSAC cannot catch the slide either.
+  double min_eigen_ratio = 0.0;
   int klt_window_px = 21;  // odd side of the KLT window
   int klt_levels = 3;      // pyramid levels above the full-resolution image
   int klt_iterations = 30;
@@ -151,6 +159,8 @@ class FeatureTracker {
   [[nodiscard]] const cv::Mat& detectionImage(const cv::Mat& left);
   std::vector<cv::Point2f> shiTomasiCorners(const cv::Mat& image);
   cv::Point2f refinedCorner(const cv::Mat& left, const cv::Point& pixel);
+  // The min_eigen_ratio check of a new corner.
+  bool notOnAnEdge(const cv::Mat& left, const cv::Point2f& corner);
   void detectNew(const cv::Mat& left, TrackerStats& stats);
   std::vector<Feature> matchStereo(TrackerStats& stats);
   // The ZNCC check of a stereo match (config_.stereo_min_zncc).
@@ -171,6 +181,7 @@ class FeatureTracker {
   cv::Mat detect_image_, detect_mask_;                    // left image and mask_ at detect_level
   cv::Mat refine_response_;                               // full-resolution response near a corner
   cv::Mat zncc_left_, zncc_right_;                        // patches of the stereo ZNCC check
+  cv::Mat edge_gx_, edge_gy_;                             // gradients of the edge check
 };
 
 }  // namespace gvio::odometry

@@ -325,6 +325,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       integer("vio.tracker.klt_window_px", e.tracker.klt_window_px),
       integer("vio.tracker.klt_levels", e.tracker.klt_levels),
       integer("vio.tracker.detect_level", e.tracker.detect_level),
+      number("vio.tracker.min_eigen_ratio", e.tracker.min_eigen_ratio),
       integer("vio.tracker.klt_iterations", e.tracker.klt_iterations),
       integer("vio.tracker.klt_refine_window_px", e.tracker.klt_refine_window_px),
       number("vio.tracker.fb_threshold_px", e.tracker.fb_threshold_px),

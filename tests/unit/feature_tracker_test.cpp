@@ -432,6 +432,8 @@ TEST(FeatureTrackerConfig, BadValuesNameTheField) {
       {"detect_level", [](TrackerConfig& c) { c.detect_level = -1; }},
       {"detect_level", [](TrackerConfig& c) { c.detect_level = 4; }},
       {"stereo_min_zncc", [](TrackerConfig& c) { c.stereo_min_zncc = 1.5; }},
+      {"min_eigen_ratio", [](TrackerConfig& c) { c.min_eigen_ratio = -0.1; }},
+      {"min_eigen_ratio", [](TrackerConfig& c) { c.min_eigen_ratio = std::nan(""); }},
       {"stereo_min_zncc", [](TrackerConfig& c) { c.stereo_min_zncc = std::nan(""); }},
   };
   for (const auto& [field, spoil] : cases) {
