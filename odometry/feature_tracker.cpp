@@ -73,8 +73,8 @@ double patchZncc(const cv::Mat& a, cv::Point2f pa, const cv::Mat& b, cv::Point2f
       bb += db * db;
     }
   }
-  // Below a tenth of a grey level's variance per pixel a patch is flat (sensor noise of 8-bit
-  // images is about 1 DN).
+  // A patch whose standard deviation is below a tenth of a grey level is flat (sensor noise of
+  // 8-bit images is about 1 DN).
   constexpr double kFlatVariance = 0.01;
   if (aa < kFlatVariance * n || bb < kFlatVariance * n) return -1.0;
   return ab / std::sqrt(aa * bb);
@@ -459,7 +459,7 @@ cv::Point2f FeatureTracker::refinedCorner(const cv::Mat& left, const cv::Point& 
 bool FeatureTracker::notOnAnEdge(const cv::Mat& left, const cv::Point2f& corner) {
   if (config_.min_eigen_ratio <= 0.0) return true;
   // The gradients of a 9 x 9 ROI (its filters read the image around it), summed over the 7 x 7
-  // inside: the covariance [a b; b c] whose eigenvalues KLT's conditioning is (Shi and Tomasi
+  // inside: the covariance [a b; b d] whose eigenvalues are KLT's conditioning (Shi and Tomasi
   // 1994).
   constexpr int kHalf = 3;
   const cv::Point c(cvRound(corner.x), cvRound(corner.y));
@@ -528,10 +528,6 @@ void FeatureTracker::detectNew(const cv::Mat& left, TrackerStats& stats) {
   stats.new_features = added;
 }
 
-// Rectified stereo: the match lies on the same row as every other match (up to the rig's
-// rectification offset, the frame's median), left of the left position. KLT starts from
-// the previous frame's disparity when the feature had one (close points sit far beyond the
-// pyramid's reach from a zero guess), else from the same position.
 bool FeatureTracker::similarPatches(const cv::Point2f& left_px, const cv::Point2f& right_px) {
   if (config_.stereo_min_zncc <= -1.0) return true;
   // Level 0 of a pyramid built with derivatives is its first entry (the image itself).
@@ -539,6 +535,10 @@ bool FeatureTracker::similarPatches(const cv::Point2f& left_px, const cv::Point2
                    zncc_right_) >= config_.stereo_min_zncc;
 }
 
+// Rectified stereo: the match lies on the same row as every other match (up to the rig's
+// rectification offset, the frame's median), left of the left position. KLT starts from
+// the previous frame's disparity when the feature had one (close points sit far beyond the
+// pyramid's reach from a zero guess), else from the same position.
 std::vector<Feature> FeatureTracker::matchStereo(TrackerStats& stats) {
   std::vector<Feature> features;
   features.reserve(tracks_.size());
