@@ -25,6 +25,7 @@
 #include "odometry/feature_tracker.hpp"
 #include "odometry/rectifier.hpp"
 #include "support/fixtures.hpp"
+#include "support/true_motion.hpp"
 
 namespace gvio::test {
 namespace {
@@ -74,14 +75,6 @@ class FeatureTrackerTest : public ::testing::Test {
     left_.clear();
     right_.clear();
     dataset_.reset();
-  }
-
-  // True camera-to-world pose of the left camera at frame k.
-  static Eigen::Isometry3d cameraPose(std::size_t k) {
-    const Trajectory& gt = *dataset_->groundtruth;
-    const auto it = std::find(gt.t_ns.begin(), gt.t_ns.end(), dataset_->frames[k].t_ns);
-    // at(): a frame without a truth pose fails the test instead of reading past the end.
-    return gt.poses.at(static_cast<std::size_t>(it - gt.t_ns.begin())) * dataset_->cameras[0].T_b_c;
   }
 
   static std::unique_ptr<io::Dataset> dataset_;
@@ -199,27 +192,7 @@ TEST_F(FeatureTrackerTest, TheRowCheckFollowsTheRigsRowOffset) {
 // Stereo features of frame k are lifted to 3-D with the true baseline, moved with the true camera
 // motion to frame k + 1 and projected: they must land where the tracker followed them.
 TEST_F(FeatureTrackerTest, TracksAgreeWithTheTrueMotion) {
-  const CameraModel& cam = dataset_->cameras[0];
-  const double baseline =
-      (dataset_->cameras[1].T_b_c.translation() - cam.T_b_c.translation()).norm();
-  std::vector<double> errors;
-  for (std::size_t k = 0; k + 1 < tracked_.size(); ++k) {
-    const Eigen::Isometry3d T_next_cur = cameraPose(k + 1).inverse() * cameraPose(k);
-    const auto next = byId(tracked_[k + 1]);
-    for (const Feature& f : tracked_[k].features) {
-      const auto it = next.find(f.id);
-      const double disparity = f.px_left.x() - f.px_right.x();
-      // Below 2 px the depth (and with it the prediction) is too uncertain to judge the track.
-      if (!f.has_right || disparity < 2.0 || it == next.end()) continue;
-      const double z = cam.fx * baseline / disparity;
-      const Eigen::Vector3d p_cur((f.px_left.x() - cam.cx) / cam.fx * z,
-                                  (f.px_left.y() - cam.cy) / cam.fy * z, z);
-      const Eigen::Vector3d p = T_next_cur * p_cur;
-      const Eigen::Vector2d predicted(cam.fx * p.x() / p.z() + cam.cx,
-                                      cam.fy * p.y() / p.z() + cam.cy);
-      errors.push_back((predicted - it->second.px_left).norm());
-    }
-  }
+  const std::vector<double> errors = trueMotionErrors(*dataset_, tracked_);
   ASSERT_GT(errors.size(), 1000u);
   std::vector<double> sorted = errors;
   std::sort(sorted.begin(), sorted.end());
