@@ -180,7 +180,7 @@ class FeatureTracker {
   // megabyte-sized allocations each frame cost more in page faults than the arithmetic on them.
   std::vector<cv::Mat> prev_pyr_, left_pyr_, right_pyr_;  // KLT pyramids with derivatives
   cv::Mat mask_;                                          // where new corners may go
-  cv::Mat response_, local_max_;                          // Shi-Tomasi response, its 3x3 maximum
+  cv::Mat response_;                                      // Shi-Tomasi response
   cv::Mat detect_image_, detect_mask_;                    // left image and mask_ at detect_level
   cv::Mat refine_response_;                               // full-resolution response near a corner
   cv::Mat zncc_left_, zncc_right_;                        // patches of the stereo ZNCC check
