@@ -161,7 +161,8 @@ for mode in modes:
 PY
 
 # The fused runs' floor on this draw: the error of the best constant offset the fixes allow with the
-# trajectory's shape known exactly (tests/bench/gnss_offset_floor.py); no fusion can beat it.
+# trajectory's shape known exactly (tests/bench/gnss_offset_floor.py): what a fusion of these
+# fixes can expect to reach at best.
 for mode in $MODES; do
   run="$OUT/${mode//:/_}"
   if [ -f "$run/georef.json" ] && [ -f "$run/gnss_fixes.csv" ]; then
