@@ -34,8 +34,8 @@ struct TrackerConfig {
   // problem). Under forward motion a lane marking points at the focus of expansion, along the
   // epipolar lines, so the fundamental-matrix RANSAC cannot catch the slide either. 0.1 took
   // stereo+IMU from 27 to 29 of the style matrix's 30 cells within 0.10 % (six seeds), but the
-  // second KITTI-00 simulation from 1.049 to 1.492 m: not the default yet (docs/vio_matrix.md,
-  // "Held-out seeds").
+  // whole KITTI-00 drive over four simulations from 0.904 to 1.161 m (geometric mean): off by
+  // default (docs/vio_matrix.md, "Held-out seeds" and "Four simulations of KITTI-00").
   double min_eigen_ratio = 0.0;
   int klt_window_px = 21;  // odd side of the KLT window
   int klt_levels = 3;      // pyramid levels above the full-resolution image
