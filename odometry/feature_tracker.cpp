@@ -41,7 +41,12 @@ constexpr int kShiTomasiBlock = 3;
 constexpr int kShiTomasiAperture = 3;
 // The reverse KLT pass starts where a correct track must end, so it needs no coarse search: one
 // level above full resolution halves its cost (VINS-Fusion does the same), and a wrong forward
-// track whose true match lies far away cannot "come back" through the coarse levels.
+// track whose true match lies far away cannot "come back" through the coarse levels. Not none:
+// at full resolution alone the check passes more tracks (sparse texture seed 1: 13 instead of 32
+// a frame rejected; likely reverse tracks that cannot leave their origin's neighbourhood), and the
+// style matrix's sparse texture drives lose (seeds 1-3: 0.100 / 0.088 / 0.076 % of the path with
+// one level, 0.178 / 0.105 / 0.227 % with none, 0.126 / 0.104 / 0.075 % with two;
+// docs/vio_matrix.md, "Fewer KLT levels").
 constexpr int kReverseLevels = 1;
 
 // Half side of the patches whose ZNCC checks a stereo match (11 x 11, the size that separated
