@@ -440,6 +440,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       boolean("sim.exposure_change", c.sim.exposure_change),
       number("sim.exposure_amplitude", c.sim.exposure_amplitude),
       number("sim.exposure_period_s", c.sim.exposure_period_s),
+      number("sim.right_camera_gain", c.sim.right_camera_gain),
       boolean("sim.motion_blur", c.sim.motion_blur),
       number("sim.exposure_time_s", c.sim.exposure_time_s),
       integer("sim.blur_samples", c.sim.blur_samples),

@@ -40,6 +40,7 @@ cv::Mat CameraSimulator::render(const ContinuousTrajectory& trajectory, std::int
     gain = static_cast<float>(1.0 + config_.exposure_amplitude *
                                         std::sin(2.0 * M_PI * t_s / config_.exposure_period_s));
   }
+  if (camera == 1) gain *= static_cast<float>(config_.right_camera_gain);
   cv::Mat image;
   if (config_.motion_blur) {
     // Average renders spread over the exposure: the stereo pair is triggered together, so both

@@ -34,6 +34,8 @@ void SimConfig::validate() const {
   require(exposure_amplitude >= 0.0 && exposure_amplitude < 1.0, "exposure_amplitude", "in [0, 1)",
           exposure_amplitude);
   require(exposure_period_s > 0.0, "exposure_period_s", "positive", exposure_period_s);
+  require(right_camera_gain >= 0.25 && right_camera_gain <= 4.0, "right_camera_gain",
+          "in [0.25, 4]", right_camera_gain);
   require(exposure_time_s > 0.0 && exposure_time_s < 1.0 / camera_rate_hz, "exposure_time_s",
           "positive and shorter than a frame", exposure_time_s);
   require(blur_samples >= 2 && blur_samples <= 32, "blur_samples", "in [2, 32]", blur_samples);

@@ -23,6 +23,9 @@ struct SimConfig {
   bool exposure_change = false;           // slow sinusoidal gain change
   double exposure_amplitude = 0.15;       // relative gain amplitude
   double exposure_period_s = 20.0;
+  // The right camera's gain relative to the left's: a rig whose cameras expose independently
+  // (1: the same exposure).
+  double right_camera_gain = 1.0;
   bool motion_blur = false;
   double exposure_time_s = 0.004;  // blur integrates over this interval
   int blur_samples = 4;            // renders averaged per blurred frame

@@ -14,7 +14,9 @@
 # and the IMU noise drawn per drive in BENCH_IMU_RANGE (MIN:MAX, default 0.5:2; the estimator
 # assumes imu.*: KITTI's oxts cannot state the drive's noise) and, with BENCH_TURN_ON (ACC:GYR,
 # 1-sigma per axis in m/s^2 and rad/s; default none), turn-on biases drawn per drive.
-# BENCH_SET ("key=value ...") adds `--set` overrides to every run (compare a setting on the matrix).
+# BENCH_SET ("key=value ...") adds `--set` overrides to every run (compare a setting on the matrix);
+# BENCH_SIM_SET ("sim.key=value ...") adds them to every simulation (sensor effects: exposure
+# changes, a stereo gain mismatch, motion blur), with its own cache folders.
 #
 #   tests/bench/vio_matrix.sh                                   # 5 styles x 3 seeds x 3 modes
 #   BENCH_STYLES="street open_road" BENCH_SEEDS="1 2" BENCH_SECONDS=30 tests/bench/vio_matrix.sh
@@ -36,6 +38,13 @@ TURN_ON_SET=()
 TURN_ON_TAG=""
 RUN_SET=()
 for kv in ${BENCH_SET:-}; do RUN_SET+=(--set "$kv"); done
+SIM_SET=()
+SIM_TAG=""
+for kv in ${BENCH_SIM_SET:-}; do
+  SIM_SET+=(--set "$kv")
+  SIM_TAG="${SIM_TAG}_${kv#sim.}"
+done
+SIM_TAG="${SIM_TAG//[^A-Za-z0-9_.=-]/_}"
 if [ -n "$TURN_ON" ]; then
   IFS=: read -r TURN_ACC TURN_GYR <<< "$TURN_ON"
   if [ -z "${TURN_ACC:-}" ] || [ -z "${TURN_GYR:-}" ]; then
@@ -106,7 +115,8 @@ simulate_drive() {
   local rc=0
   "$GVIO" simulate "${traj[@]}" --gnss-noise spp --seed "$seed" --seconds "$DRIVE_S" \
     --world-style "$style" --set "sim.imu_noise_scale_min=$IMU_MIN" \
-    --set "sim.imu_noise_scale_max=$IMU_MAX" "${TURN_ON_SET[@]}" --out "$cache.partial" --force \
+    --set "sim.imu_noise_scale_max=$IMU_MAX" ${TURN_ON_SET[@]+"${TURN_ON_SET[@]}"} \
+    ${SIM_SET[@]+"${SIM_SET[@]}"} --out "$cache.partial" --force \
     --no-progress \
     > "$cache.partial/simulate.log" 2>&1 || rc=$?
   [ -n "$tmp" ] && rm -rf "$tmp"
@@ -126,7 +136,7 @@ if [ -z "${BENCH_TABLE_ONLY:-}" ]; then
     for seed in $SEEDS; do
       start=0
       [ "$TRAJ_KIND" = kitti00 ] && start="$(kitti_start "$seed")"
-      cache="$CACHE_ROOT/vio_matrix_${TRAJ_TAG}_t${start}_${DRIVE_S}s_${style}_seed${seed}_imu${IMU_MIN}-${IMU_MAX}${TURN_ON_TAG}"
+      cache="$CACHE_ROOT/vio_matrix_${TRAJ_TAG}_t${start}_${DRIVE_S}s_${style}_seed${seed}_imu${IMU_MIN}-${IMU_MAX}${TURN_ON_TAG}${SIM_TAG}"
       cell="$OUT/${style}_seed${seed}"
       mkdir -p "$cell"
       echo "$cache" > "$cell/drive.txt"

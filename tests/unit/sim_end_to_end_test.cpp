@@ -243,6 +243,16 @@ TEST_F(SimEndToEnd, MotionBlurAndExposureChange) {
   EXPECT_LT(sharpness(blurred), 0.9 * sharpness(plain));
   // At t = 0.5 s of a 2 s period the gain is 1 + 0.15 sin(pi / 2) = 1.15.
   EXPECT_GT(cv::mean(bright)[0], 1.08 * cv::mean(plain)[0]);
+  // A right camera exposed 20 % brighter: its image only.
+  const auto right = [&](const std::string& name) {
+    return cv::imread((dir_->path() / name / "image_01" / "data" / "0000000005.png").string(),
+                      cv::IMREAD_GRAYSCALE);
+  };
+  const cv::Mat left_of_brighter_right = run("right",
+                                             "--set sim.image_noise_dn=0 --set "
+                                             "sim.right_camera_gain=1.2");
+  EXPECT_EQ(cv::norm(left_of_brighter_right, plain, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::mean(right("right"))[0], 1.12 * cv::mean(right("plain"))[0]);
 }
 
 // --world-style (or sim.world_style) picks the world: recorded in sim.yaml, another world.ply.
@@ -370,6 +380,9 @@ TEST_F(SimEndToEnd, BadInputIsOneLineExit2) {
       {"simulate --trajectory " + traj + " --set sim.imu_turn_on_acc_bias_mps2=-1 --out " +
            (d / "x9").string(),
        "sim.imu_turn_on_acc_bias_mps2"},
+      {"simulate --trajectory " + traj + " --set sim.right_camera_gain=0 --out " +
+           (d / "x10").string(),
+       "sim.right_camera_gain"},
   };
   for (const auto& [args, needle] : cases) {
     const auto r = runGvio(args + " --no-progress");
