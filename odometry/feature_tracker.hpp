@@ -69,6 +69,12 @@ struct TrackerConfig {
   // correct match there 0.77 or more, and 99.8 % of KITTI-00's matches 0.7 or more
   // (docs/vio_matrix.md, "Corners from the half-resolution level").
   double stereo_min_zncc = -1.0;
+  // Exposure changes (odometry/photometric_gain.hpp): when the median brightness ratio of the
+  // matched patches between the previous and this left image (or between the left and the right
+  // image) is further from 1 than this, the image is divided by it and the points are tracked
+  // (matched) again; 0: never. Below it the images are used as they are, so a drive without
+  // exposure changes gives the same tracks as with none.
+  double gain_threshold = 0.02;
   bool stereo = true;
 
   void validate() const;  // throws InvalidInput naming the field
@@ -102,6 +108,9 @@ struct TrackerStats {
   int stereo_matches = 0;
   int rejected_stereo = 0;  // stereo KLT failures, forward-backward, epipolar or disparity sign
   double stereo_row_offset_px = 0.0;  // the frame's median right y - left y (0: no candidates)
+  // Gains removed (TrackerConfig::gain_threshold): this left image against the previous one, the
+  // right image against the left one; 1 where none was.
+  double exposure_gain = 1.0, stereo_gain = 1.0;
   // Informational wall-clock timings of the three stages (not asserted anywhere).
   double ms_detect = 0, ms_track = 0, ms_stereo = 0;
 };
@@ -166,6 +175,13 @@ class FeatureTracker {
   bool notOnAnEdge(const cv::Mat& left, const cv::Point2f& corner);
   void detectNew(const cv::Mat& left, TrackerStats& stats);
   std::vector<Feature> matchStereo(TrackerStats& stats);
+  // With the points tracked from `from` into `to` (`to_px`, `ok`, started at `start_px`): when
+  // their patches say `to` is brighter or darker by more than config_.gain_threshold, tracks them
+  // again into `to` with that gain removed and returns it; else 1 (nothing changed).
+  double removeExposureGain(const std::vector<cv::Mat>& from, const std::vector<cv::Mat>& to,
+                            const std::vector<cv::Point2f>& from_px,
+                            const std::vector<cv::Point2f>& start_px,
+                            std::vector<cv::Point2f>& to_px, std::vector<bool>& ok);
   // The ZNCC check of a stereo match (config_.stereo_min_zncc).
   bool similarPatches(const cv::Point2f& left_px, const cv::Point2f& right_px);
 
@@ -179,6 +195,8 @@ class FeatureTracker {
   // Image buffers kept from frame to frame only so that OpenCV reuses their memory: fresh
   // megabyte-sized allocations each frame cost more in page faults than the arithmetic on them.
   std::vector<cv::Mat> prev_pyr_, left_pyr_, right_pyr_;  // KLT pyramids with derivatives
+  cv::Mat gain_image_;                                    // an image with its exposure gain removed
+  std::vector<cv::Mat> gain_pyr_;                         // and its pyramid
   cv::Mat mask_;                                          // where new corners may go
   cv::Mat response_;                                      // Shi-Tomasi response
   cv::Mat detect_image_, detect_mask_;                    // left image and mask_ at detect_level

@@ -344,6 +344,8 @@ FrameResult VioEstimator::processFrame(std::int64_t t_ns, const TrackedFrame& tr
   const auto start_estimator = Clock::now();
   FrameResult r = s.process(t_ns, tracked);
   s.last_features = tracked.features;
+  if (tracked.stats.exposure_gain != 1.0) ++s.counters.exposure_corrected_frames;
+  if (tracked.stats.stereo_gain != 1.0) ++s.counters.stereo_gain_corrected_frames;
   r.ms_tracking = ms_tracking;
   r.ms_estimator = msSince(start_estimator);
   if (!r.T_w_b.matrix().allFinite() || !r.v_w_mps.allFinite()) {

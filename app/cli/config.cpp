@@ -332,6 +332,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("vio.tracker.ransac_threshold_px", e.tracker.ransac_threshold_px),
       number("vio.tracker.stereo_max_vertical_px", e.tracker.stereo_max_vertical_px),
       number("vio.tracker.stereo_min_zncc", e.tracker.stereo_min_zncc),
+      number("vio.tracker.gain_threshold", e.tracker.gain_threshold),
       number("vio.tracker.klt_predict_min_px", e.tracker.klt_predict_min_px),
       text("fusion.origin", c.fusion.origin),
       vector3("fusion.lever_arm_b", c.fusion.fusion.lever_arm_b),

@@ -86,6 +86,8 @@ json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportCon
                       {"lost_frames", c.lost_frames},
                       {"coasted_frames", c.coasted_frames},
                       {"imu_gaps", c.imu_gaps},
+                      {"exposure_corrected_frames", c.exposure_corrected_frames},
+                      {"stereo_gain_corrected_frames", c.stereo_gain_corrected_frames},
                       {"frames_skipped_unreadable", run.frames_skipped_unreadable},
                       {"poses_written", run.trajectory.size()},
                       {"poses_nonfinite", run.nonfinite_poses}};

@@ -242,10 +242,14 @@ TEST_F(CliRunEndToEnd, ReportHasTheContractFields) {
   EXPECT_EQ(r["dataset"]["gnss_fixes"], 9);
   EXPECT_EQ(r["mode"], "stereo-imu");
   EXPECT_EQ(r["rectification"]["identity"], true);  // the simulator renders rectified cameras
-  for (const char* key : {"frames", "keyframes", "initializations", "lost_frames", "coasted_frames",
-                          "imu_gaps", "frames_skipped_unreadable"}) {
+  for (const char* key :
+       {"frames", "keyframes", "initializations", "lost_frames", "coasted_frames", "imu_gaps",
+        "exposure_corrected_frames", "stereo_gain_corrected_frames", "frames_skipped_unreadable"}) {
     EXPECT_TRUE(r["counts"].contains(key)) << key;
   }
+  // The simulator's exposure is constant unless asked for (sim.exposure_change).
+  EXPECT_EQ(r["counts"]["exposure_corrected_frames"], 0);
+  EXPECT_EQ(r["counts"]["stereo_gain_corrected_frames"], 0);
   EXPECT_EQ(r["counts"]["frames"], 81);
   EXPECT_GE(r["counts"]["keyframes"].get<int>(), 1);
   EXPECT_GE(r["counts"]["initializations"].get<int>(), 1);

@@ -408,6 +408,9 @@ TEST(FeatureTrackerConfig, BadValuesNameTheField) {
       {"min_eigen_ratio", [](TrackerConfig& c) { c.min_eigen_ratio = -0.1; }},
       {"min_eigen_ratio", [](TrackerConfig& c) { c.min_eigen_ratio = std::nan(""); }},
       {"stereo_min_zncc", [](TrackerConfig& c) { c.stereo_min_zncc = std::nan(""); }},
+      {"gain_threshold", [](TrackerConfig& c) { c.gain_threshold = -0.01; }},
+      {"gain_threshold", [](TrackerConfig& c) { c.gain_threshold = 1.0; }},
+      {"gain_threshold", [](TrackerConfig& c) { c.gain_threshold = std::nan(""); }},
   };
   for (const auto& [field, spoil] : cases) {
     TrackerConfig c;
