@@ -274,7 +274,7 @@ TEST(FeatureTrackerExposureRun, ADriveWithExposureChangesIsCorrected) {
   EXPECT_LT(ape_on, ape_off);
 }
 
-// The real EuRoC V1_01 clip: its right camera's images are about a tenth darker than the left
+// The real EuRoC V1_01 clip: its right camera's images are about 15 % darker than the left
 // one's (an independently exposed rig), and every pair is matched with that gain removed.
 TEST(FeatureTrackerExposureEuroc, ARealRigsRightCameraIsCorrected) {
   const std::filesystem::path root = sharedData("euroc_v101_micro");
@@ -300,7 +300,8 @@ TEST(FeatureTrackerExposureEuroc, ARealRigsRightCameraIsCorrected) {
             << matches_corrected << " corrected, " << matches_uncorrected << " not\n";
   EXPECT_LT(quantile(gains, 0.9), 0.98);
   EXPECT_GT(quantile(gains, 0.1), 0.8);
-  EXPECT_GE(matches_corrected, matches_uncorrected);
+  // 6055 against 1417 (2026-11-30).
+  EXPECT_GT(matches_corrected, 2 * matches_uncorrected);
 }
 
 }  // namespace
