@@ -23,6 +23,7 @@
 #include "odometry/photometric_gain.hpp"
 #include "odometry/rectifier.hpp"
 #include "support/fixtures.hpp"
+#include "support/tracker_drive.hpp"
 #include "support/true_motion.hpp"
 
 namespace gvio::test {
@@ -107,14 +108,10 @@ TEST(PhotometricGain, TooFewPatchesGiveNoGain) {
 class FeatureTrackerExposureTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    const std::filesystem::path drive = cachedSimulation(fmt::format(
-        "--trajectory {}/assets/demo/drive.tum --seconds 3 --seed 11", GVIO_SOURCE_DIR));
-    dataset_ =
-        std::make_unique<io::Dataset>(io::readDataset(drive, std::nullopt, io::ReaderConfig{}));
-    for (const auto& f : dataset_->frames) {
-      left_.push_back(io::loadGrayImage(f.image_paths[0], dataset_->cameras[0]));
-      right_.push_back(io::loadGrayImage(f.image_paths[1], dataset_->cameras[1]));
-    }
+    StereoDrive drive = trackerTestDrive();
+    dataset_ = std::make_unique<io::Dataset>(std::move(drive.dataset));
+    left_ = std::move(drive.left);
+    right_ = std::move(drive.right);
   }
   static void TearDownTestSuite() {
     left_.clear();

@@ -25,6 +25,7 @@
 #include "odometry/feature_tracker.hpp"
 #include "odometry/rectifier.hpp"
 #include "support/fixtures.hpp"
+#include "support/tracker_drive.hpp"
 #include "support/true_motion.hpp"
 
 namespace gvio::test {
@@ -52,16 +53,12 @@ class FeatureTrackerTest : public ::testing::Test {
  protected:
   // One 3 s simulated drive (31 stereo frames) and the default tracker's output on it.
   static void SetUpTestSuite() {
-    const std::filesystem::path drive = cachedSimulation(fmt::format(
-        "--trajectory {}/assets/demo/drive.tum --seconds 3 --seed 11", GVIO_SOURCE_DIR));
-    dataset_ =
-        std::make_unique<io::Dataset>(io::readDataset(drive, std::nullopt, io::ReaderConfig{}));
+    StereoDrive drive = trackerTestDrive();
+    dataset_ = std::make_unique<io::Dataset>(std::move(drive.dataset));
     ASSERT_EQ(dataset_->cameras.size(), 2u);
     ASSERT_EQ(dataset_->frames.size(), 31u);
-    for (const auto& f : dataset_->frames) {
-      left_.push_back(io::loadGrayImage(f.image_paths[0], dataset_->cameras[0]));
-      right_.push_back(io::loadGrayImage(f.image_paths[1], dataset_->cameras[1]));
-    }
+    left_ = std::move(drive.left);
+    right_ = std::move(drive.right);
     FeatureTracker tracker{TrackerConfig{}};
     for (std::size_t k = 0; k < left_.size(); ++k)
       tracked_.push_back(tracker.track(dataset_->frames[k].t_ns, left_[k], right_[k]));
