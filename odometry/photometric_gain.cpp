@@ -69,7 +69,8 @@ std::optional<double> medianPatchGain(const cv::Mat& from, const cv::Mat& to,
     if (!matched[i]) continue;
     const auto a = patchMean(from, from_px[i], half_px);
     const auto b = patchMean(to, to_px[i], half_px);
-    if (a && b && *a > 0.0) ratios.push_back(*b / *a);
+    // Unclipped patches have means of at least kDarkestUnclipped: the ratio is finite.
+    if (a && b) ratios.push_back(*b / *a);
   }
   if (static_cast<int>(ratios.size()) < std::max(min_points, 1)) return std::nullopt;
   // The lower median for an even count: one patch's ratio, not a mean of two.
