@@ -10,6 +10,7 @@
 #include <numeric>
 #include <string>
 
+#include "odometry/corner_candidates.hpp"
 #include "odometry/error.hpp"
 #include "odometry/photometric_gain.hpp"
 
@@ -203,18 +204,6 @@ std::vector<bool> kltForwardBackward(const std::vector<cv::Mat>& from,
   return ok;
 }
 
-// The largest response where the mask is set, 0 if none is larger: what cv::minMaxLoc with a mask
-// gives whenever it matters (the threshold is at least kMinCornerResponse > 0 either way), in one
-// branch-free pass that the compiler vectorises (cv::minMaxLoc's masked path does not).
-float maskedMaximum(const cv::Mat& response, const cv::Mat& mask) {
-  float best = 0.0F;
-  for (int y = 0; y < response.rows; ++y) {
-    const auto* r = response.ptr<float>(y);
-    const auto* m = mask.ptr<std::uint8_t>(y);
-    for (int x = 0; x < response.cols; ++x) best = std::max(best, m[x] != 0 ? r[x] : 0.0F);
-  }
-  return best;
-}
 }  // namespace
 
 void TrackerConfig::validate() const {
@@ -454,27 +443,9 @@ std::vector<cv::Point2f> FeatureTracker::shiTomasiCorners(const cv::Mat& image) 
   const auto threshold = static_cast<float>(
       std::max(config_.quality_level * static_cast<double>(maskedMaximum(response_, *mask)),
                kMinCornerResponse));
-  // A candidate is a local maximum: no response of its 3 x 3 neighbourhood is larger. Tested only
-  // where the threshold and the mask let a pixel through (a few per cent of them), which gives the
-  // same candidates as a dilated copy of the whole response compared pixel by pixel.
-  std::vector<std::pair<float, int>> candidates;  // response, raster index
-  for (int y = 1; y + 1 < image.rows; ++y) {
-    const auto* above = response_.ptr<float>(y - 1);
-    const auto* r = response_.ptr<float>(y);
-    const auto* below = response_.ptr<float>(y + 1);
-    const auto* allowed = mask->ptr<std::uint8_t>(y);
-    for (int x = 1; x + 1 < image.cols; ++x) {
-      const float v = r[x];
-      if (v < threshold || allowed[x] == 0) continue;
-      if (v < r[x - 1] || v < r[x + 1] || v < above[x - 1] || v < above[x] || v < above[x + 1] ||
-          v < below[x - 1] || v < below[x] || v < below[x + 1])
-        continue;
-      candidates.emplace_back(v, y * image.cols + x);
-    }
-  }
-  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
-    return a.first != b.first ? a.first > b.first : a.second < b.second;
-  });
+  // A candidate is a local maximum: no response of its 3 x 3 neighbourhood is larger.
+  const std::vector<std::pair<float, int>> candidates =
+      localMaximumCandidates(response_, *mask, threshold);
   // pyrDown's pixel (x, y) is centred on (2x, 2y) of the level below.
   std::vector<cv::Point2f> corners(candidates.size());
   for (std::size_t i = 0; i < candidates.size(); ++i) {

@@ -196,6 +196,9 @@ SolveStats SlidingWindow::solve(bool use_imu) {
   popts.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   popts.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   popts.context = context_.get();
+  // The checks guard against caller errors (a block added twice to one residual, sizes that do not
+  // match) that the tests cover; they cost a sort and hash lookups per residual block, every frame.
+  popts.disable_all_safety_checks = true;
   ceres::Problem problem(popts);
   std::vector<std::shared_ptr<ceres::CostFunction>> alive;  // the problem does not own them
   const auto add = [&](std::shared_ptr<ceres::CostFunction> cost, const ceres::LossFunction* loss,
