@@ -26,6 +26,7 @@ constexpr double kMinCornerResponse = 3e-4;
 // defaults).
 constexpr int kShiTomasiBlock = 3;
 constexpr int kShiTomasiAperture = 3;
+
 }  // namespace
 
 // Features that drifted within min_distance of a longer-lived one are dropped (VINS-Fusion's
