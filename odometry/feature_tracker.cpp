@@ -69,6 +69,21 @@ void requirePositive(const char* field, double value) {
   }
 }
 
+// cv::calcOpticalFlowPyrLK computes a per-point error measure unless told not to (cv::noArray()),
+// one more pass over every window at full resolution; nothing here reads it. Computing it is also
+// where OpenCV fails a point whose final window starts beyond one window outside the image
+// (lkpyramid.cpp, LKTrackerInvoker): the same test, done here, keeps every status as it was.
+void markOutOfReach(const std::vector<cv::Point2f>& px, const cv::Size& win, const cv::Size& image,
+                    std::vector<std::uint8_t>& status) {
+  const cv::Point2f half_win((static_cast<float>(win.width) - 1.0F) * 0.5F,
+                             (static_cast<float>(win.height) - 1.0F) * 0.5F);
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    const cv::Point2f corner = px[i] - half_win;
+    const int x = cvFloor(corner.x), y = cvFloor(corner.y);
+    if (x < -win.width || x >= image.width || y < -win.height || y >= image.height) status[i] = 0;
+  }
+}
+
 }  // namespace
 
 namespace tracker_detail {
@@ -85,22 +100,24 @@ std::vector<bool> kltForwardBackward(const std::vector<cv::Mat>& from,
   const cv::TermCriteria term(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, c.klt_iterations,
                               kKltEpsilonPx);
   std::vector<std::uint8_t> status, back_status;
-  std::vector<float> err;
-  cv::calcOpticalFlowPyrLK(from, to, from_px, to_px, status, err, win, c.klt_levels, term,
+  cv::calcOpticalFlowPyrLK(from, to, from_px, to_px, status, cv::noArray(), win, c.klt_levels, term,
                            use_guess ? cv::OPTFLOW_USE_INITIAL_FLOW : 0);
+  markOutOfReach(to_px, win, to[0].size(), status);
   if (c.klt_refine_window_px > 0) {
     // Full resolution only (level 0 of the same pyramids), from the pyramidal result.
     std::vector<std::uint8_t> refined;
     const cv::Size refine_win(c.klt_refine_window_px, c.klt_refine_window_px);
-    cv::calcOpticalFlowPyrLK(from, to, from_px, to_px, refined, err, refine_win, 0, term,
+    cv::calcOpticalFlowPyrLK(from, to, from_px, to_px, refined, cv::noArray(), refine_win, 0, term,
                              cv::OPTFLOW_USE_INITIAL_FLOW);
+    markOutOfReach(to_px, refine_win, to[0].size(), refined);
     for (std::size_t i = 0; i < status.size(); ++i) status[i] = status[i] != 0 && refined[i] != 0;
   }
   // The reverse pass starts at the original position: a correct track comes straight back.
   std::vector<cv::Point2f> back_px = from_px;
-  cv::calcOpticalFlowPyrLK(to, from, to_px, back_px, back_status, err, win,
+  cv::calcOpticalFlowPyrLK(to, from, to_px, back_px, back_status, cv::noArray(), win,
                            std::min(c.klt_levels, kReverseLevels), term,
                            cv::OPTFLOW_USE_INITIAL_FLOW);
+  markOutOfReach(back_px, win, from[0].size(), back_status);
   std::vector<bool> ok(from_px.size());
   for (std::size_t i = 0; i < ok.size(); ++i) {
     ok[i] = status[i] != 0 && back_status[i] != 0 &&
