@@ -21,7 +21,6 @@
 #include "io/image_loader.hpp"
 #include "odometry/feature_tracker.hpp"
 #include "odometry/photometric_gain.hpp"
-#include "odometry/rectifier.hpp"
 #include "support/fixtures.hpp"
 #include "support/tracker_drive.hpp"
 #include "support/true_motion.hpp"
@@ -274,20 +273,14 @@ TEST(FeatureTrackerExposureRun, ADriveWithExposureChangesIsCorrected) {
 // The real EuRoC V1_01 clip: its right camera's images are about 15 % darker than the left
 // one's (an independently exposed rig), and every pair is matched with that gain removed.
 TEST(FeatureTrackerExposureEuroc, ARealRigsRightCameraIsCorrected) {
-  const std::filesystem::path root = sharedData("euroc_v101_micro");
-  if (root.empty()) GTEST_SKIP() << "shared data absent: euroc_v101_micro";
-  const io::Dataset ds = io::readDataset(root, std::nullopt, io::ReaderConfig{});
-  ASSERT_EQ(ds.cameras.size(), 2U);
-  const odometry::Rectifier rectifier(ds.cameras[0], ds.cameras[1]);
+  const std::vector<StereoPair> pairs = eurocClipRectified();
+  if (pairs.empty()) GTEST_SKIP() << "shared data absent: euroc_v101_micro";
   FeatureTracker corrected{TrackerConfig{}}, uncorrected{withGainThreshold(0.0)};
   std::vector<double> gains;
   int matches_corrected = 0, matches_uncorrected = 0;
-  for (std::size_t k = 0; k < ds.frames.size(); k += 2) {
-    const odometry::RectifiedImages images =
-        rectifier.rectify(io::loadGrayImage(ds.frames[k].image_paths[0], ds.cameras[0]),
-                          io::loadGrayImage(ds.frames[k].image_paths[1], ds.cameras[1]));
-    const TrackedFrame a = corrected.track(ds.frames[k].t_ns, images.left, images.right);
-    const TrackedFrame b = uncorrected.track(ds.frames[k].t_ns, images.left, images.right);
+  for (const StereoPair& p : pairs) {
+    const TrackedFrame a = corrected.track(p.t_ns, p.left, p.right);
+    const TrackedFrame b = uncorrected.track(p.t_ns, p.left, p.right);
     gains.push_back(a.stats.stereo_gain);
     matches_corrected += a.stats.stereo_matches;
     matches_uncorrected += b.stats.stereo_matches;

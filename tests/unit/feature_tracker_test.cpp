@@ -23,7 +23,6 @@
 #include "io/trajectory_io.hpp"
 #include "odometry/error.hpp"
 #include "odometry/feature_tracker.hpp"
-#include "odometry/rectifier.hpp"
 #include "support/fixtures.hpp"
 #include "support/tracker_drive.hpp"
 #include "support/true_motion.hpp"
@@ -421,22 +420,16 @@ TEST(FeatureTrackerConfig, BadValuesNameTheField) {
 // median offset keeps most of what a 2 px tolerance keeps on a real rig (2026-11-29: 87 %; 94 %
 // since the exposure correction matches this rig's darker right camera).
 TEST(FeatureTrackerEuroc, TheRowCheckKeepsARealRigsMatches) {
-  const std::filesystem::path root = sharedData("euroc_v101_micro");
-  if (root.empty()) GTEST_SKIP() << "shared data absent: euroc_v101_micro";
-  const io::Dataset ds = io::readDataset(root, std::nullopt, io::ReaderConfig{});
-  ASSERT_EQ(ds.cameras.size(), 2U);
-  const odometry::Rectifier rectifier(ds.cameras[0], ds.cameras[1]);
+  const std::vector<StereoPair> pairs = eurocClipRectified();
+  if (pairs.empty()) GTEST_SKIP() << "shared data absent: euroc_v101_micro";
   TrackerConfig wide;
   wide.stereo_max_vertical_px = 2.0;
   FeatureTracker tight_tracker{TrackerConfig{}}, wide_tracker{wide};
   int tight = 0, loose = 0;
   double max_offset = 0.0;
-  for (std::size_t k = 0; k < ds.frames.size(); k += 2) {
-    const odometry::RectifiedImages images =
-        rectifier.rectify(io::loadGrayImage(ds.frames[k].image_paths[0], ds.cameras[0]),
-                          io::loadGrayImage(ds.frames[k].image_paths[1], ds.cameras[1]));
-    const TrackedFrame a = tight_tracker.track(ds.frames[k].t_ns, images.left, images.right);
-    const TrackedFrame b = wide_tracker.track(ds.frames[k].t_ns, images.left, images.right);
+  for (const StereoPair& p : pairs) {
+    const TrackedFrame a = tight_tracker.track(p.t_ns, p.left, p.right);
+    const TrackedFrame b = wide_tracker.track(p.t_ns, p.left, p.right);
     tight += a.stats.stereo_matches;
     loose += b.stats.stereo_matches;
     max_offset = std::max(max_offset, std::abs(a.stats.stereo_row_offset_px));
