@@ -17,6 +17,9 @@
 # BENCH_SET ("key=value ...") adds `--set` overrides to every run (compare a setting on the matrix);
 # BENCH_SIM_SET ("sim.key=value ...") adds them to every simulation (sensor effects: exposure
 # changes, a stereo gain mismatch, motion blur), with its own cache folders.
+# BENCH_IMU_NOISE=truth:K tells the estimator each drive's own IMU noise (its sim.yaml) times K,
+# as a dataset that states its noise would (default: imu.*, which the drives' noise is drawn
+# around): the measure of how far the stated noise should be inflated.
 #
 #   tests/bench/vio_matrix.sh                                   # 5 styles x 3 seeds x 3 modes
 #   BENCH_STYLES="street open_road" BENCH_SEEDS="1 2" BENCH_SECONDS=30 tests/bench/vio_matrix.sh
@@ -55,6 +58,15 @@ if [ -n "$TURN_ON" ]; then
     "sim.imu_turn_on_gyr_bias_radps=$TURN_GYR")
   TURN_ON_TAG="_bias${TURN_ACC}-${TURN_GYR}"
 fi
+NOISE_K=""
+if [ -n "${BENCH_IMU_NOISE:-}" ]; then
+  NOISE_K="${BENCH_IMU_NOISE#truth:}"
+  if [ "$NOISE_K" = "$BENCH_IMU_NOISE" ] || ! [[ "$NOISE_K" =~ ^[0-9]*\.?[0-9]+$ ]] ||
+    ! awk -v k="$NOISE_K" 'BEGIN { exit !(k > 0) }'; then
+    echo "bench: BENCH_IMU_NOISE must be truth:K (K > 0), not '$BENCH_IMU_NOISE'" >&2
+    exit 2
+  fi
+fi
 CACHE_ROOT="${GVIO_BENCH_CACHE:-$BUILD_DIR/bench_cache}"
 OUT="${BENCH_OUT:-out/bench/vio_matrix}"
 IFS=: read -r IMU_MIN IMU_MAX <<< "$IMU_RANGE"
@@ -92,6 +104,22 @@ seed, stride, dur = int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
 span = max(times[-1] - times[0] - dur, 0.0)
 start = ((seed - 1) * stride) % span if span > 0 else 0.0
 print(f"{start:g}")
+PY
+}
+
+# The drive's own IMU noise (sim.yaml's imu_noise densities) times K, as `--set imu.*=` pairs.
+truth_noise_set() {
+  python3 - "$1/sim.yaml" "$2" <<'PY'
+import re, sys
+text, k = open(sys.argv[1]).read(), float(sys.argv[2])
+block = re.search(r"^imu_noise:\n((?:[ ]+.*\n)+)", text, re.M)
+if not block:
+    sys.exit(f"bench: {sys.argv[1]}: no imu_noise block")
+for key in ("acc_noise_density", "gyr_noise_density", "acc_random_walk", "gyr_random_walk"):
+    value = re.search(rf"^\s+{key}:\s*([0-9.eE+-]+)", block.group(1), re.M)
+    if not value:
+        sys.exit(f"bench: {sys.argv[1]}: imu_noise has no {key}")
+    print(f"imu.{key}={k * float(value.group(1)):.9g}")
 PY
 }
 
@@ -154,9 +182,15 @@ if [ -z "${BENCH_TABLE_ONLY:-}" ]; then
           continue
         fi
         echo "bench: $style seed $seed $mode" >&2
+        noise_set=()
+        if [ -n "$NOISE_K" ]; then
+          while read -r kv; do noise_set+=(--set "$kv"); done < <(truth_noise_set "$cache" "$NOISE_K")
+          [ "${#noise_set[@]}" -eq 8 ] || { echo "bench: no IMU noise in $cache/sim.yaml" >&2; exit 2; }
+        fi
         run_rc=0
         "$GVIO" run --dataset "$cache" --gnss off --set "vio.mode=$mode" --set map.enabled=false \
-          --set loops.enabled=false ${RUN_SET[@]+"${RUN_SET[@]}"} --out "$run" --no-progress \
+          --set loops.enabled=false ${noise_set[@]+"${noise_set[@]}"} ${RUN_SET[@]+"${RUN_SET[@]}"} \
+          --out "$run" --no-progress \
           > "$run/run.log" 2>&1 || run_rc=$?
         eval_rc=-1
         if [ "$run_rc" -eq 0 ] && [ -s "$run/trajectory_vio.tum" ]; then
@@ -170,6 +204,9 @@ if [ -z "${BENCH_TABLE_ONLY:-}" ]; then
   done
 fi
 
+if [ -n "$NOISE_K" ]; then
+  echo "estimator's IMU noise: each drive's own (sim.yaml) x $NOISE_K (BENCH_IMU_NOISE)"
+fi
 python3 - "$OUT" "$CACHE_ROOT" "$DRIVE_S" "$IMU_RANGE" "$TRAJ_TAG" "$STYLES" "$SEEDS" "$MODES" <<'PY'
 import json, os, re, sys
 out, cache_root, drive_s, imu_range, traj_tag = sys.argv[1:6]
