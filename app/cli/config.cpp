@@ -283,6 +283,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       text("dataset.topics.gnss", c.dataset.topic_gnss),
       number("dataset.stereo_sync_tolerance_s", c.dataset.stereo_sync_tolerance_s),
       boolean("imu.prefer_dataset_noise", c.imu.prefer_dataset_noise),
+      number("imu.dataset_noise_scale", c.imu.dataset_noise_scale),
       number("imu.acc_noise_density", c.imu.noise.acc_noise_density),
       number("imu.gyr_noise_density", c.imu.noise.gyr_noise_density),
       number("imu.acc_random_walk", c.imu.noise.acc_random_walk),

@@ -50,10 +50,9 @@ int runInspect(const InspectOptions& opt, const CommonOptions& common) {
   io::Dataset ds = io::openDataset(sources, config.dataset);
   for (const auto& w : ds.warnings) spdlog::warn("{}", w);
   const std::size_t images = checkImages(ds, opt.quick, common.progressStyle());
-  const bool dataset_noise = ds.imu_noise && config.imu.prefer_dataset_noise;
-  const ImuNoise noise = dataset_noise ? *ds.imu_noise : config.imu.noise;
-  auto summary = io::summarizeDataset(ds, config.dataset.gap_factor, noise,
-                                      dataset_noise ? "dataset" : "config");
+  const run::ImuConfig::Choice imu_noise = config.imu.choose(ds.imu_noise);
+  auto summary =
+      io::summarizeDataset(ds, config.dataset.gap_factor, imu_noise.noise, imu_noise.source);
   summary["images_checked"] = images;
   std::cout << io::formatSummary(summary)
             << fmt::format("images    {} decoded and size-checked{}\n", images,

@@ -70,9 +70,8 @@ void loadDataset(RunState& s) {
 bool runGnssInsInstead(RunState& s) {
   const io::Dataset& ds = s.dataset;
   if (!wantsGnssIns(ds) || s.request.gnss == "off") return false;
-  const bool dataset_noise = ds.imu_noise && s.config.imu.prefer_dataset_noise;
-  const fusion::InsConfig ins =
-      s.config.fusion.insConfig(dataset_noise ? *ds.imu_noise : s.config.imu.noise);
+  const ImuConfig::Choice imu_noise = s.config.imu.choose(ds.imu_noise);
+  const fusion::InsConfig ins = s.config.fusion.insConfig(imu_noise.noise);
   const fs::path& out = s.request.out;
   spdlog::info("{} {} ({}): no camera frames, {} IMU samples, {} fixes: GNSS/INS",
                io::toString(ds.format), ds.root.string(), ds.variant, ds.imu.size(),
@@ -89,7 +88,7 @@ bool runGnssInsInstead(RunState& s) {
   context.command_line = s.request.command_line;
   context.gnss_requested = s.request.gnss;
   context.gnss_noise = s.gnss_noise;
-  context.imu_noise_source = dataset_noise ? "dataset" : "config";
+  context.imu_noise_source = imu_noise.source;
   context.peak_rss_mb = peakRssMb();
   context.evaluation = evaluation ? &*evaluation : nullptr;
   io::writeTextAtomic(out / "report.json", gnssInsReport(ds, r, context).dump(2) + "\n");

@@ -41,12 +41,11 @@ void runVioStage(RunState& s) {
   s.estimator = s.config.vio.estimator;
   s.estimator.mode = chooseVioMode(s.config.vio.mode, ds);
   s.fusion = s.config.fusion.fusionFor(s.estimator.mode);
-  const bool dataset_noise = ds.imu_noise && s.config.imu.prefer_dataset_noise;
-  s.estimator.imu_noise = dataset_noise ? *ds.imu_noise : s.config.imu.noise;
+  const ImuConfig::Choice imu_noise = s.config.imu.choose(ds.imu_noise);
+  s.estimator.imu_noise = imu_noise.noise;
   s.estimator.validate();
   warnImuGaps(ds, s.estimator);
-  if (odometry::usesImu(s.estimator.mode))
-    s.imu_noise_source = dataset_noise ? "dataset" : "config";
+  if (odometry::usesImu(s.estimator.mode)) s.imu_noise_source = imu_noise.source;
   const std::filesystem::path& out = s.request.out;
   spdlog::info("{} {} ({}): {} frames, mode {}", io::toString(ds.format), ds.root.string(),
                ds.variant, ds.frames.size(), odometry::toString(s.estimator.mode));

@@ -1,10 +1,30 @@
 #include "run/run_config.hpp"
 
+#include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "odometry/error.hpp"
 
 namespace gvio::run {
+
+ImuConfig::Choice ImuConfig::choose(const std::optional<ImuNoise>& dataset_noise) const {
+  if (!dataset_noise || !prefer_dataset_noise) return {noise, "config"};
+  ImuNoise scaled = *dataset_noise;
+  scaled.acc_noise_density *= dataset_noise_scale;
+  scaled.gyr_noise_density *= dataset_noise_scale;
+  scaled.acc_random_walk *= dataset_noise_scale;
+  scaled.gyr_random_walk *= dataset_noise_scale;
+  return {scaled, "dataset"};
+}
+
+void ImuConfig::validate() const {
+  if (!std::isfinite(dataset_noise_scale) || dataset_noise_scale <= 0.0) {
+    throw InvalidInput("config: imu.dataset_noise_scale must be a positive number (got " +
+                       std::to_string(dataset_noise_scale) + ")");
+  }
+  noise.validate();
+}
 
 std::optional<fusion::Lla> FusionAppConfig::originLla() const {
   if (origin == "first-fix") return std::nullopt;
@@ -77,7 +97,7 @@ void VioConfig::validate() const {
 
 void RunConfig::validate() const {
   dataset.validate();
-  imu.noise.validate();
+  imu.validate();
   vio.validate();
   fusion.validate();
   map.map.validate();

@@ -63,6 +63,30 @@ TEST(Config, FileThenOverrides) {
   EXPECT_FALSE(c.imu.prefer_dataset_noise);
 }
 
+// The dataset's stated noise, scaled, unless the config's is preferred; imu.* never scaled.
+TEST(Config, ImuNoiseChoiceScalesTheDatasetsNoiseOnly) {
+  run::ImuConfig c;
+  c.dataset_noise_scale = 2.5;
+  c.noise.acc_noise_density = 0.01;
+  ImuNoise stated;
+  stated.acc_noise_density = 1e-3;
+  stated.gyr_noise_density = 2e-4;
+  stated.acc_random_walk = 3e-5;
+  stated.gyr_random_walk = 4e-6;
+  const run::ImuConfig::Choice from_dataset = c.choose(stated);
+  EXPECT_STREQ(from_dataset.source, "dataset");
+  EXPECT_DOUBLE_EQ(from_dataset.noise.acc_noise_density, 2.5e-3);
+  EXPECT_DOUBLE_EQ(from_dataset.noise.gyr_noise_density, 5e-4);
+  EXPECT_DOUBLE_EQ(from_dataset.noise.acc_random_walk, 7.5e-5);
+  EXPECT_DOUBLE_EQ(from_dataset.noise.gyr_random_walk, 1e-5);
+  const run::ImuConfig::Choice without = c.choose(std::nullopt);
+  EXPECT_STREQ(without.source, "config");
+  EXPECT_DOUBLE_EQ(without.noise.acc_noise_density, 0.01);
+  c.prefer_dataset_noise = false;
+  EXPECT_STREQ(c.choose(stated).source, "config");
+  EXPECT_DOUBLE_EQ(c.choose(stated).noise.acc_noise_density, 0.01);
+}
+
 TEST(Config, UnknownFileKeyWarnsAndIsReported) {
   test::TempDir dir("config");
   test::writeText(dir.path() / "c.yaml", "dataset:\n  gap_factr: 4\n");
@@ -88,6 +112,10 @@ TEST(Config, ValidateRejectsOutOfRange) {
               HasSubstr("imu.gyr_noise_density"));
   EXPECT_THAT(errorOf({std::nullopt, {"dataset.kitti_gnss_source=gps"}}),
               HasSubstr("kitti_gnss_source"));
+  EXPECT_THAT(errorOf({std::nullopt, {"imu.dataset_noise_scale=0"}}),
+              HasSubstr("imu.dataset_noise_scale must be a positive number"));
+  EXPECT_THAT(errorOf({std::nullopt, {"imu.dataset_noise_scale=-2"}}),
+              HasSubstr("imu.dataset_noise_scale"));
   EXPECT_THAT(errorOf({std::nullopt, {"imu.prefer_dataset_noise=maybe"}}),
               HasSubstr("true or false"));
   EXPECT_THAT(errorOf({std::nullopt, {"dataset.gap_factor=nan"}}), HasSubstr("finite"));
