@@ -191,6 +191,7 @@ json gnssInsReport(const io::Dataset& ds, const InsRunResult& r, const InsReport
   report["dataset"] = datasetJson(ds);
   report["mode"] = "gnss-ins";
   report["imu_noise_source"] = ctx.imu_noise_source;
+  report["imu_noise"] = imuNoiseJson(ctx.imu_noise);
   report["counts"] = {{"imu_samples", s.imu_samples},
                       {"imu_before_init", s.imu_before_init},
                       {"imu_gaps", s.imu_gaps},

@@ -13,6 +13,7 @@
 #include "fusion/gnss_ins.hpp"
 #include "fusion/gnss_screening.hpp"
 #include "io/dataset.hpp"
+#include "odometry/measurements.hpp"
 
 namespace gvio::run {
 
@@ -60,6 +61,7 @@ struct InsReportContext {
   std::string gnss_requested;
   nlohmann::json gnss_noise;     // --gnss-noise applied to the fixes, null when none
   std::string imu_noise_source;  // "dataset" or "config"
+  ImuNoise imu_noise;            // the model the filter used
   double peak_rss_mb = 0.0;
   const InsEvaluation* evaluation = nullptr;  // null: no truth in the run's frame
 };

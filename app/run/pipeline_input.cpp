@@ -89,6 +89,7 @@ bool runGnssInsInstead(RunState& s) {
   context.gnss_requested = s.request.gnss;
   context.gnss_noise = s.gnss_noise;
   context.imu_noise_source = imu_noise.source;
+  context.imu_noise = imu_noise.noise;
   context.peak_rss_mb = peakRssMb();
   context.evaluation = evaluation ? &*evaluation : nullptr;
   io::writeTextAtomic(out / "report.json", gnssInsReport(ds, r, context).dump(2) + "\n");

@@ -94,6 +94,7 @@ void writeReport(RunState& s) {
   context.gnss_requested = s.request.gnss;
   context.gnss_noise = s.gnss_noise;
   context.imu_noise_source = s.imu_noise_source;
+  if (!s.imu_noise_source.empty()) context.imu_noise = s.estimator.imu_noise;
   context.peak_rss_mb = peakRssMb();
   context.evaluation = s.evaluation ? &*s.evaluation : nullptr;
   context.evaluation_loop_closed = e.loop_closed ? &*e.loop_closed : nullptr;

@@ -1,11 +1,13 @@
 #pragma once
 // report.json of `gvio run` (DESIGN.md section 4): what ran on what, counts, per-frame timings,
 // memory, GNSS use, estimator events and, with ground truth, the evaluation.
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "io/dataset.hpp"
+#include "odometry/measurements.hpp"
 #include "run/evaluation.hpp"
 #include "run/gnss_run.hpp"
 #include "run/vio_runner.hpp"
@@ -19,6 +21,7 @@ struct ReportContext {
   nlohmann::json map;                  // run/map_run.hpp mapReport, null without a map
   nlohmann::json loops;                // run/loop_run.hpp loopsReport, null without loop closure
   std::string imu_noise_source;        // "dataset" or "config"; empty when the mode has no IMU
+  std::optional<ImuNoise> imu_noise;   // the model the estimator used; none without an IMU
   double peak_rss_mb = 0.0;
   const EvaluationOutcome* evaluation = nullptr;  // null: the dataset has no ground truth
   // The loop-closed trajectory in the VIO world (trajectory.tum without GNSS), SE(3) aligned as
@@ -29,6 +32,9 @@ struct ReportContext {
   // The causal (online) fused trajectory when trajectory.tum is the smoothed one; else null.
   const UnalignedOutcome* evaluation_fused_online = nullptr;
 };
+
+// report.json's "imu_noise": the four densities an estimator used (after imu.dataset_noise_scale).
+nlohmann::json imuNoiseJson(const ImuNoise& noise);
 
 // report.json's "dataset": path, format, variant, sensor counts, IMU rate, ground truth source
 // (shared by the VIO and the GNSS/INS reports).

@@ -1,5 +1,6 @@
 // `gvio inspect` end to end through the built binary: the summary of a valid drive (text and
 // JSON), and the one-line error with exit code 2 for broken input and bad usage.
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -123,6 +124,37 @@ TEST(CliUsage, UnknownOptionIsBadUsage) {
   const auto r = test::runGvio("inspect --dataset . --no-such-option");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.out + r.err, HasSubstr("--no-such-option"));
+}
+
+// A dataset that states its IMU noise (EuRoC sensor.yaml, the simulator's own figures): used
+// times imu.dataset_noise_scale unless imu.* is preferred, which is never scaled.
+TEST(CliInspectImuNoise, TheStatedNoiseTimesTheScale) {
+  const fs::path drive = test::cachedSimulation(
+      fmt::format("--trajectory {}/assets/demo/drive.tum --seconds 8 --seed 4 --format euroc",
+                  GVIO_SOURCE_DIR));
+  test::TempDir dir("cli_inspect_noise");
+  const auto noise = [&](const std::string& set) {
+    const fs::path json = dir.path() / "summary.json";
+    const test::CommandResult r = inspect(drive, "--quick --json " + quoted(json) + " " + set);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return nlohmann::json::parse(test::readText(json))["imu"]["noise"];
+  };
+  const nlohmann::json stated = noise("");
+  EXPECT_EQ(stated["source"], "dataset");
+  const nlohmann::json scaled = noise("--set imu.dataset_noise_scale=3");
+  EXPECT_EQ(scaled["source"], "dataset");
+  for (const char* key :
+       {"acc_noise_density", "gyr_noise_density", "acc_random_walk", "gyr_random_walk"}) {
+    EXPECT_GT(stated[key].get<double>(), 0.0) << key;
+    EXPECT_NEAR(scaled[key].get<double>(), 3.0 * stated[key].get<double>(),
+                1e-12 * stated[key].get<double>())
+        << key;
+  }
+  const nlohmann::json config = noise(
+      "--set imu.dataset_noise_scale=3 --set imu.prefer_dataset_noise=false "
+      "--set imu.acc_noise_density=0.05");
+  EXPECT_EQ(config["source"], "config");
+  EXPECT_DOUBLE_EQ(config["acc_noise_density"].get<double>(), 0.05);
 }
 
 TEST(CliUsage, UnknownFormatIsBadUsage) {

@@ -241,6 +241,12 @@ TEST_F(CliRunEndToEnd, ReportHasTheContractFields) {
   EXPECT_EQ(r["dataset"]["imu_samples"], 801);
   EXPECT_EQ(r["dataset"]["gnss_fixes"], 9);
   EXPECT_EQ(r["mode"], "stereo-imu");
+  // KITTI's layout states no IMU noise: imu.*, as configured.
+  EXPECT_EQ(r["imu_noise_source"], "config");
+  EXPECT_DOUBLE_EQ(r["imu_noise"].value("acc_noise_density", -1.0),
+                   cli::AppConfig{}.imu.noise.acc_noise_density);
+  EXPECT_DOUBLE_EQ(r["imu_noise"].value("gyr_random_walk", -1.0),
+                   cli::AppConfig{}.imu.noise.gyr_random_walk);
   EXPECT_EQ(r["rectification"]["identity"], true);  // the simulator renders rectified cameras
   for (const char* key :
        {"frames", "keyframes", "initializations", "lost_frames", "coasted_frames", "imu_gaps",
