@@ -30,9 +30,19 @@ float maskedMaximum(const cv::Mat& response, const cv::Mat& mask) {
     const cv::v_float32x4 zero = cv::v_setzero_f32();
     const cv::v_uint32x4 zero_u = cv::v_setzero_u32();
     cv::v_float32x4 best4 = zero;
-    for (; x + 4 <= response.cols; x += 4) {
-      const cv::v_float32x4 inside = cv::v_reinterpret_as_f32(cv::v_load_expand_q(m + x) != zero_u);
-      best4 = cv::v_max(best4, cv::v_select(inside, cv::v_load(r + x), zero));
+    // 16 mask bytes by one unaligned load, widened to 4 x 4 lanes (cv::v_load_expand_q would read
+    // 4 bytes as one int: a misaligned load where the row or x is not a multiple of 4, undefined
+    // behaviour that UBSan stops at).
+    for (; x + 16 <= response.cols; x += 16) {
+      cv::v_uint16x8 m_lo, m_hi;
+      cv::v_expand(cv::v_load(m + x), m_lo, m_hi);
+      cv::v_uint32x4 m4[4];
+      cv::v_expand(m_lo, m4[0], m4[1]);
+      cv::v_expand(m_hi, m4[2], m4[3]);
+      for (int k = 0; k < 4; ++k) {
+        const cv::v_float32x4 inside = cv::v_reinterpret_as_f32(m4[k] != zero_u);
+        best4 = cv::v_max(best4, cv::v_select(inside, cv::v_load(r + x + 4 * k), zero));
+      }
     }
     best = std::max(best, cv::v_reduce_max(best4));
 #endif
