@@ -116,6 +116,13 @@ StreamStats streamStats(const std::vector<std::int64_t>& t, double gap_factor) {
   return s;
 }
 
+json imuNoiseJson(const ImuNoise& noise) {
+  return {{"acc_noise_density", noise.acc_noise_density},
+          {"gyr_noise_density", noise.gyr_noise_density},
+          {"acc_random_walk", noise.acc_random_walk},
+          {"gyr_random_walk", noise.gyr_random_walk}};
+}
+
 json summarizeDataset(const Dataset& ds, double gap_factor, const ImuNoise& noise,
                       const std::string& noise_source) {
   json j;
@@ -144,11 +151,8 @@ json summarizeDataset(const Dataset& ds, double gap_factor, const ImuNoise& nois
     const auto t = stampsOf(ds.imu);
     span(t);
     j["imu"] = statsJson(streamStats(t, gap_factor));
-    j["imu"]["noise"] = {{"source", noise_source},
-                         {"acc_noise_density", noise.acc_noise_density},
-                         {"gyr_noise_density", noise.gyr_noise_density},
-                         {"acc_random_walk", noise.acc_random_walk},
-                         {"gyr_random_walk", noise.gyr_random_walk}};
+    j["imu"]["noise"] = imuNoiseJson(noise);
+    j["imu"]["noise"]["source"] = noise_source;
   }
   if (!ds.gnss.empty()) {
     span(stampsOf(ds.gnss));

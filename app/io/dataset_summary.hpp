@@ -23,6 +23,10 @@ struct StreamStats {
 
 StreamStats streamStats(const std::vector<std::int64_t>& stamps_ns, double gap_factor);
 
+// An IMU noise model's four densities (inspect's summary, and report.json's "imu_noise": the model
+// an estimator used, a dataset's after imu.dataset_noise_scale).
+nlohmann::json imuNoiseJson(const ImuNoise& noise);
+
 // `imu_noise` is the effective noise model (dataset's or config's) and `imu_noise_source` where
 // it came from.
 nlohmann::json summarizeDataset(const Dataset& dataset, double gap_factor,

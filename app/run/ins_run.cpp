@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "io/atomic_write.hpp"
+#include "io/dataset_summary.hpp"
 #include "io/trajectory_io.hpp"
 #include "odometry/error.hpp"
 #include "run/gnss_run.hpp"
@@ -191,7 +192,7 @@ json gnssInsReport(const io::Dataset& ds, const InsRunResult& r, const InsReport
   report["dataset"] = datasetJson(ds);
   report["mode"] = "gnss-ins";
   report["imu_noise_source"] = ctx.imu_noise_source;
-  report["imu_noise"] = imuNoiseJson(ctx.imu_noise);
+  report["imu_noise"] = io::imuNoiseJson(ctx.imu_noise);
   report["counts"] = {{"imu_samples", s.imu_samples},
                       {"imu_before_init", s.imu_before_init},
                       {"imu_gaps", s.imu_gaps},

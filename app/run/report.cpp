@@ -61,13 +61,6 @@ json datasetJson(const io::Dataset& ds) {
   return j;
 }
 
-json imuNoiseJson(const ImuNoise& noise) {
-  return {{"acc_noise_density", noise.acc_noise_density},
-          {"gyr_noise_density", noise.gyr_noise_density},
-          {"acc_random_walk", noise.acc_random_walk},
-          {"gyr_random_walk", noise.gyr_random_walk}};
-}
-
 json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportContext& ctx) {
   json report;
   report["gvio_version"] = GVIO_VERSION;
@@ -77,7 +70,7 @@ json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportCon
   report["mode"] = odometry::toString(run.mode);
   report["imu_noise_source"] =
       ctx.imu_noise_source.empty() ? json(nullptr) : json(ctx.imu_noise_source);
-  report["imu_noise"] = ctx.imu_noise ? imuNoiseJson(*ctx.imu_noise) : json(nullptr);
+  report["imu_noise"] = ctx.imu_noise ? io::imuNoiseJson(*ctx.imu_noise) : json(nullptr);
   // The lens model the rectifier undistorted (a stereo pair shares one); "none" for pinholes.
   std::string distortion = "none";
   const std::size_t used = odometry::usesStereo(run.mode) ? 2 : 1;

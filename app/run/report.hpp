@@ -33,9 +33,6 @@ struct ReportContext {
   const UnalignedOutcome* evaluation_fused_online = nullptr;
 };
 
-// report.json's "imu_noise": the four densities an estimator used (after imu.dataset_noise_scale).
-nlohmann::json imuNoiseJson(const ImuNoise& noise);
-
 // report.json's "dataset": path, format, variant, sensor counts, IMU rate, ground truth source
 // (shared by the VIO and the GNSS/INS reports).
 nlohmann::json datasetJson(const io::Dataset& dataset);
