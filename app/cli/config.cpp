@@ -485,6 +485,12 @@ AppConfig loadConfig(const ConfigSources& sources, std::vector<std::string>* unk
   return config;
 }
 
+AppConfig loadRunConfig(const std::filesystem::path& run_dir) {
+  ConfigSources sources;
+  if (std::filesystem::exists(run_dir / "config.yaml")) sources.file = run_dir / "config.yaml";
+  return loadConfig(sources);
+}
+
 std::string dumpConfigYaml(const AppConfig& config) {
   AppConfig copy = config;  // configKeys binds mutable references
   YAML::Emitter out;

@@ -50,6 +50,10 @@ struct ConfigSources {
 AppConfig loadConfig(const ConfigSources& sources,
                      std::vector<std::string>* unknown_keys = nullptr);
 
+// The configuration a finished run used: RUN/config.yaml when present (an older run may have
+// none: the defaults then), as loadConfig reads a --config file.
+AppConfig loadRunConfig(const std::filesystem::path& run_dir);
+
 // The effective configuration as YAML, every key with its value (reproducible runs).
 std::string dumpConfigYaml(const AppConfig& config);
 

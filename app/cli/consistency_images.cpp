@@ -11,12 +11,11 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/config.hpp"
-#include "cli/render_camera.hpp"
 #include "eval/image_check_plot.hpp"
 #include "io/atomic_write.hpp"
 #include "io/image_loader.hpp"
 #include "io/input_error.hpp"
-#include "io/run_dir.hpp"
+#include "io/run_map.hpp"
 #include "mapping/consistency.hpp"
 #include "odometry/error.hpp"
 #include "viz/camera_view.hpp"
@@ -272,13 +271,12 @@ int runImageConsistency(const ImageConsistencyRequest& r) {
   if (!fs::is_directory(fs::absolute(out).parent_path())) {
     throw io::InputError(out, 0, "output folder's parent does not exist");
   }
-  const io::RunFiles run = readMapRun(r.run, /*with_cloud=*/false);  // the check rebuilds the map
-  const Trajectory& traj = viz::mapTrajectory(run);
+  // The check rebuilds the map: map.pcd is not read.
+  const io::RunFiles run = io::readMapRun(r.run, /*with_cloud=*/false);
+  const Trajectory& traj = io::mapTrajectory(run);
+  const AppConfig app = loadRunConfig(r.run);
   std::string mode;
-  const io::Dataset ds = reopenRunDataset(r.run, r.dataset, mode);
-  ConfigSources config;
-  if (fs::exists(r.run / "config.yaml")) config.file = r.run / "config.yaml";
-  const AppConfig app = loadConfig(config);
+  const io::Dataset ds = io::reopenRunDataset(r.run, r.dataset, app.dataset, mode);
   viz::ImageCheck check(run, ds, app.map.map.dense, r.check);
   const std::int64_t t0_ns = traj.t_ns.front();
   const std::vector<std::size_t> todo = keyframesToCheck(check, r, t0_ns);

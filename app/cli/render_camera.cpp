@@ -7,11 +7,9 @@
 #include <limits>
 
 #include "cli/config.hpp"
-#include "io/dataset_sources.hpp"
 #include "io/image_loader.hpp"
 #include "io/input_error.hpp"
-#include "io/run_dir.hpp"
-#include "io/run_sources.hpp"
+#include "io/run_map.hpp"
 #include "odometry/error.hpp"
 #include "odometry/rectifier.hpp"
 #include "render/egl_context.hpp"
@@ -43,30 +41,6 @@ std::size_t nearestFrame(const io::Dataset& ds, std::int64_t t_ns) {
   return best;
 }
 
-}  // namespace
-
-io::Dataset reopenRunDataset(const fs::path& run_dir, const std::optional<fs::path>& dataset,
-                             std::string& mode) {
-  const fs::path report = run_dir / "report.json";
-  const io::RunSources recorded = io::readRunSources(report);
-  mode = recorded.mode;
-  if (!recorded.dataset && !dataset) {
-    throw io::InputError(
-        report, 0, "no \"sources\" (a run by an older gvio): name the dataset with --dataset");
-  }
-  io::DatasetSources sources = recorded.dataset.value_or(io::DatasetSources{});
-  if (dataset) {
-    sources.dataset = *dataset;
-    sources.format.reset();
-  }
-  ConfigSources config;
-  if (fs::exists(run_dir / "config.yaml")) config.file = run_dir / "config.yaml";
-  const AppConfig app = loadConfig(config);
-  return io::openDataset(sources, app.dataset);
-}
-
-namespace {
-
 bool stereoMode(const fs::path& run_dir, const std::string& mode) {
   try {
     return odometry::usesStereo(odometry::parseVioMode(mode));
@@ -77,18 +51,6 @@ bool stereoMode(const fs::path& run_dir, const std::string& mode) {
 }
 
 }  // namespace
-
-io::RunFiles readMapRun(const fs::path& run_dir, bool with_cloud) {
-  if (const auto warning = io::incompleteRunWarning(run_dir)) spdlog::warn("{}", *warning);
-  io::RunReadOptions read;
-  read.cloud = with_cloud;
-  read.occupancy = read.gnss_fixes = read.outages = read.loops = false;
-  io::RunFiles run = io::readRunDir(run_dir, read);
-  if (!viz::mapTrajectory(run).hasTimestamps()) {
-    throw io::InputError(run_dir, 0, "the trajectory has no timestamps");
-  }
-  return run;
-}
 
 struct RecordedCameraOverlay::State {
   io::RunFiles run;
@@ -109,9 +71,9 @@ RecordedCameraOverlay::RecordedCameraOverlay(const fs::path& run_dir,
                                              viz::OverlayMode overlay)
     : state_(std::make_unique<State>()) {
   State& s = *state_;
-  s.run = readMapRun(run_dir);
+  s.run = io::readMapRun(run_dir);
   std::string mode;
-  s.ds = reopenRunDataset(run_dir, dataset, mode);
+  s.ds = io::reopenRunDataset(run_dir, dataset, loadRunConfig(run_dir).dataset, mode);
   if (s.ds.cameras.empty()) throw InvalidInput(s.ds.root.string() + ": no camera");
   s.stereo = stereoMode(run_dir, mode) && s.ds.cameras.size() >= 2;
   s.rectifier.emplace(s.ds.cameras[0],
@@ -176,7 +138,7 @@ int renderCameraView(const CameraRenderRequest& r) {
   options.ahead_s = r.ahead_s;
   options.colour = viz::parseMapColour(r.map_colour);
   const RecordedCameraOverlay overlayer(r.run, r.dataset, options, overlay);
-  const Trajectory& traj = viz::mapTrajectory(overlayer.run());
+  const Trajectory& traj = io::mapTrajectory(overlayer.run());
   const std::int64_t wanted_ns = traj.t_ns.front() + static_cast<std::int64_t>(r.at_s * 1e9);
   std::string info;
   io::writePng(r.out, overlayer.at(wanted_ns, &info));

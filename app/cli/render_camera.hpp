@@ -52,15 +52,4 @@ class RecordedCameraOverlay {
 
 int renderCameraView(const CameraRenderRequest& request);
 
-// The dataset as the run opened it (report.json "sources", its config.yaml's reader settings);
-// `dataset` overrides the recorded sources. `mode` gets the run's VIO mode. InputError naming
-// report.json when it records no sources and none is given.
-io::Dataset reopenRunDataset(const std::filesystem::path& run_dir,
-                             const std::optional<std::filesystem::path>& dataset,
-                             std::string& mode);
-
-// The run's trajectories and (with_cloud) map.pcd, not the occupancy, fixes, outages or loops;
-// warns when the run did not complete. InputError when the trajectory has no timestamps.
-io::RunFiles readMapRun(const std::filesystem::path& run_dir, bool with_cloud = true);
-
 }  // namespace gvio::cli

@@ -14,7 +14,7 @@
 #include "io/atomic_write.hpp"
 #include "io/input_error.hpp"
 #include "io/quiet_stderr.hpp"
-#include "io/run_dir.hpp"
+#include "io/run_map.hpp"
 #include "odometry/error.hpp"
 #include "render/annotate.hpp"
 #include "render/egl_context.hpp"
@@ -102,7 +102,7 @@ double driveTimeS(const Trajectory& traj, std::int64_t t_ns) {
 // The whole map and trajectory from a chase camera that follows the body. The map is uploaded
 // once, in ground tiles, and each frame draws the tiles near and ahead of the camera.
 int followVideo(const VideoRequest& r, const io::RunFiles& run) {
-  const Trajectory& traj = viz::mapTrajectory(run);
+  const Trajectory& traj = io::mapTrajectory(run);
   const auto times = viz::videoFrameTimes(traj, r.fps, r.speed, r.span);
   render::Scene scene;
   std::vector<Eigen::Vector3d> centres;
@@ -147,7 +147,7 @@ int followVideo(const VideoRequest& r, const io::RunFiles& run) {
 
 // The top-down map revealed along the path driven so far.
 int topDownVideo(const VideoRequest& r, const io::RunFiles& run) {
-  const Trajectory& traj = viz::mapTrajectory(run);
+  const Trajectory& traj = io::mapTrajectory(run);
   const auto times = viz::videoFrameTimes(traj, r.fps, r.speed, r.span);
   const viz::ViewSpec spec = viz::buildTopDownMapOnly(run, r.width, r.height);
   const render::EglContext context;
@@ -172,7 +172,7 @@ int cameraVideo(const VideoRequest& r) {
   viz::CameraViewOptions options;
   options.colour = viz::parseMapColour(r.map_colour);
   const RecordedCameraOverlay overlay(r.run, r.dataset, options, viz::parseOverlayMode(r.overlay));
-  const Trajectory& traj = viz::mapTrajectory(overlay.run());
+  const Trajectory& traj = io::mapTrajectory(overlay.run());
   const auto times = viz::videoFrameTimes(traj, r.fps, r.speed, r.span);
   encode(r, times, overlay.width(), overlay.height(), [&](std::int64_t t_ns) {
     cv::Mat bgr = overlay.at(t_ns);

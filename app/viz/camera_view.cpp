@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fusion/vio_enu_alignment.hpp"
+#include "io/run_map.hpp"
 #include "odometry/error.hpp"
 #include "render/colormap.hpp"
 #include "viz/map_layers.hpp"
@@ -33,7 +34,7 @@ std::vector<Eigen::Vector3d> positionsBetween(const Trajectory& traj, std::int64
 }
 
 std::vector<Eigen::Vector3d> pathAhead(const io::RunFiles& run, std::int64_t t_ns, double ahead_s) {
-  return positionsBetween(mapTrajectory(run), t_ns,
+  return positionsBetween(io::mapTrajectory(run), t_ns,
                           t_ns + static_cast<std::int64_t>(ahead_s * 1e9));
 }
 
@@ -85,15 +86,9 @@ render::PinholeIntrinsics renderIntrinsics(const CameraModel& camera, double nea
   return K;
 }
 
-const Trajectory& mapTrajectory(const io::RunFiles& run) {
-  if (run.fused && !run.fused->empty()) return *run.fused;
-  if (run.vio && !run.vio->empty()) return *run.vio;
-  throw InvalidInput(run.dir.string() + ": no trajectory to place the camera on");
-}
-
 std::optional<Eigen::Isometry3d> cameraPoseAt(const io::RunFiles& run, std::int64_t t_ns,
                                               const Eigen::Isometry3d& T_b_c) {
-  const Trajectory& traj = mapTrajectory(run);
+  const Trajectory& traj = io::mapTrajectory(run);
   if (!traj.hasTimestamps()) return std::nullopt;
   const auto T_map_b = fusion::interpolatePose(traj, t_ns);
   if (!T_map_b) return std::nullopt;

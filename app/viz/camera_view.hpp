@@ -32,9 +32,6 @@ MapColour parseMapColour(const std::string& name);  // InvalidInput for anything
 // The render intrinsics of a rectified (pinhole, undistorted) camera.
 render::PinholeIntrinsics renderIntrinsics(const CameraModel& camera, double near_m, double far_m);
 
-// The trajectory map.pcd is expressed along: trajectory.tum, else trajectory_vio.tum.
-const Trajectory& mapTrajectory(const io::RunFiles& run);
-
 // The camera at `t_ns` on the map trajectory: T_map_c = T_map_b(t) T_b_c (pose interpolated);
 // nullopt when t is outside the trajectory or inside a gap of it.
 std::optional<Eigen::Isometry3d> cameraPoseAt(const io::RunFiles& run, std::int64_t t_ns,
