@@ -29,12 +29,8 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 BUILD_DIR="${BUILD_DIR:-build}"
 GVIO="$BUILD_DIR/app/gvio"
-DATA="${GVIO_SHARED_DATA:-../shared/data}/kitti00"
-STYLES="${BENCH_STYLES:-street open_road sparse_texture repetitive vegetation}"
 SEEDS="${BENCH_SEEDS:-1 2 3}"
 MODES="${BENCH_MODES:-stereo-imu stereo mono-imu}"
-DRIVE_S="${BENCH_SECONDS:-60}"
-STRIDE_S="${BENCH_START_STRIDE:-150}"
 IMU_RANGE="${BENCH_IMU_RANGE:-0.5:2}"
 TURN_ON="${BENCH_TURN_ON:-}"
 TURN_ON_SET=()
@@ -67,7 +63,6 @@ if [ -n "${BENCH_IMU_NOISE:-}" ]; then
     exit 2
   fi
 fi
-CACHE_ROOT="${GVIO_BENCH_CACHE:-$BUILD_DIR/bench_cache}"
 OUT="${BENCH_OUT:-out/bench/vio_matrix}"
 IFS=: read -r IMU_MIN IMU_MAX <<< "$IMU_RANGE"
 if [ -z "${IMU_MIN:-}" ] || [ -z "${IMU_MAX:-}" ]; then
@@ -75,37 +70,7 @@ if [ -z "${IMU_MIN:-}" ] || [ -z "${IMU_MAX:-}" ]; then
   exit 2
 fi
 
-# The trajectory: a window of KITTI-00 per seed, or one file for every seed.
-TRAJ_KIND="file"
-TRAJ=""
-TIMES=""
-if [ -n "${BENCH_TRAJECTORY:-}" ]; then
-  TRAJ="$BENCH_TRAJECTORY"
-  TIMES="${BENCH_TIMES:-}"
-elif [ -f "$DATA/KITTI_00_gt.txt" ] && [ -f "$DATA/KITTI_00_gt_times.txt" ]; then
-  TRAJ_KIND=kitti00
-else
-  TRAJ="assets/demo/drive.tum"
-  echo "bench: $DATA absent: driving assets/demo/drive.tum (35 s, the same route for every seed)" >&2
-fi
-TRAJ_TAG=kitti00
-if [ "$TRAJ_KIND" = file ]; then
-  TRAJ_TAG="$(basename "$TRAJ")"
-  TRAJ_TAG="${TRAJ_TAG%.*}"
-  TRAJ_TAG="${TRAJ_TAG//[^A-Za-z0-9_-]/_}"
-fi
-
-# Start of seed SEED's window into KITTI-00 (s): (seed - 1) x stride, wrapped into the drive.
-kitti_start() {
-  python3 - "$DATA/KITTI_00_gt_times.txt" "$1" "$STRIDE_S" "$DRIVE_S" <<'PY'
-import sys
-times = [float(l) for l in open(sys.argv[1]) if l.strip()]
-seed, stride, dur = int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
-span = max(times[-1] - times[0] - dur, 0.0)
-start = ((seed - 1) * stride) % span if span > 0 else 0.0
-print(f"{start:g}")
-PY
-}
+source tests/bench/matrix_drives.sh
 
 # The drive's own IMU noise (sim.yaml's imu_noise densities) times K, as `--set imu.*=` pairs.
 truth_noise_set() {
@@ -123,86 +88,45 @@ for key in ("acc_noise_density", "gyr_noise_density", "acc_random_walk", "gyr_ra
 PY
 }
 
-# Simulates one drive into the cache (once); prints nothing, returns the simulator's exit code.
-simulate_drive() {
-  local style=$1 seed=$2 start=$3 cache=$4
-  [ -f "$cache/sim.yaml" ] && return 0
-  local traj=("--trajectory" "$TRAJ") tmp=""
-  [ -n "$TIMES" ] && traj+=(--times "$TIMES")
-  if [ "$TRAJ_KIND" = kitti00 ]; then
-    # The window as its own KITTI trajectory (poses in KITTI-00's world; the simulator starts the
-    # stamps at its default epoch), in a temporary folder: no copy of the shared data stays.
-    tmp="$(mktemp -d)"
-    python3 tests/bench/kitti00_window.py "$DATA/KITTI_00_gt.txt" "$DATA/KITTI_00_gt_times.txt" \
-      "$start" "$tmp"
-    traj=(--trajectory "$tmp/kitti00_window.txt" --times "$tmp/kitti00_window_times.txt")
-  fi
-  echo "bench: simulating $style seed $seed (${DRIVE_S} s from ${start} s) into $cache" >&2
-  rm -rf "$cache.partial"
-  mkdir -p "$cache.partial"
-  local rc=0
-  "$GVIO" simulate "${traj[@]}" --gnss-noise spp --seed "$seed" --seconds "$DRIVE_S" \
-    --world-style "$style" --set "sim.imu_noise_scale_min=$IMU_MIN" \
-    --set "sim.imu_noise_scale_max=$IMU_MAX" ${TURN_ON_SET[@]+"${TURN_ON_SET[@]}"} \
-    ${SIM_SET[@]+"${SIM_SET[@]}"} --out "$cache.partial" --force \
-    --no-progress \
-    > "$cache.partial/simulate.log" 2>&1 || rc=$?
-  [ -n "$tmp" ] && rm -rf "$tmp"
-  if [ "$rc" -ne 0 ]; then
-    echo "bench: simulation failed (exit $rc): $cache.partial/simulate.log" >&2
-    return "$rc"
-  fi
-  echo "trajectory: ${TRAJ_TAG} start_s: ${start} seconds: ${DRIVE_S}" > "$cache.partial/bench_drive.txt"
-  rm -rf "$cache"
-  mv "$cache.partial" "$cache"
+# One cell: its drive simulated (once), then every mode run and evaluated.
+run_cell() {
+  local style=$1 seed=$2
+  echo "$cache" > "$cell/drive.txt"
+  echo "$start" > "$cell/start_s.txt"
+  sim_rc=0
+  simulate_drive "$style" "$seed" "$start" "$cache" || sim_rc=$?
+  echo "$sim_rc" > "$cell/simulate_rc.txt"
+  for mode in $MODES; do
+    run="$cell/$mode"
+    if [ -n "${BENCH_RESUME:-}" ] && [ -f "$run/rc.txt" ]; then continue; fi
+    rm -rf "$run"
+    mkdir -p "$run"
+    if [ "$sim_rc" -ne 0 ]; then
+      echo "simulate $sim_rc" > "$run/rc.txt"
+      continue
+    fi
+    echo "bench: $style seed $seed $mode" >&2
+    noise_set=()
+    if [ -n "$NOISE_K" ]; then
+      while read -r kv; do noise_set+=(--set "$kv"); done < <(truth_noise_set "$cache" "$NOISE_K")
+      [ "${#noise_set[@]}" -eq 8 ] || { echo "bench: no IMU noise in $cache/sim.yaml" >&2; exit 2; }
+    fi
+    run_rc=0
+    "$GVIO" run --dataset "$cache" --gnss off --set "vio.mode=$mode" --set map.enabled=false \
+      --set loops.enabled=false ${noise_set[@]+"${noise_set[@]}"} ${RUN_SET[@]+"${RUN_SET[@]}"} \
+      --out "$run" --no-progress \
+      > "$run/run.log" 2>&1 || run_rc=$?
+    eval_rc=-1
+    if [ "$run_rc" -eq 0 ] && [ -s "$run/trajectory_vio.tum" ]; then
+      eval_rc=0
+      "$GVIO" eval --ref "$cache/groundtruth.tum" --est "$run/trajectory_vio.tum" --align se3 \
+        --json "$run/eval.json" > "$run/eval.log" 2>&1 || eval_rc=$?
+    fi
+    echo "run $run_rc eval $eval_rc" > "$run/rc.txt"
+  done
 }
 
-if [ -z "${BENCH_TABLE_ONLY:-}" ]; then
-  [ -x "$GVIO" ] || { echo "bench: $GVIO not built (./setup.sh build)" >&2; exit 2; }
-  mkdir -p "$OUT"
-  for style in $STYLES; do
-    for seed in $SEEDS; do
-      start=0
-      [ "$TRAJ_KIND" = kitti00 ] && start="$(kitti_start "$seed")"
-      cache="$CACHE_ROOT/vio_matrix_${TRAJ_TAG}_t${start}_${DRIVE_S}s_${style}_seed${seed}_imu${IMU_MIN}-${IMU_MAX}${TURN_ON_TAG}${SIM_TAG}"
-      cell="$OUT/${style}_seed${seed}"
-      mkdir -p "$cell"
-      echo "$cache" > "$cell/drive.txt"
-      echo "$start" > "$cell/start_s.txt"
-      sim_rc=0
-      simulate_drive "$style" "$seed" "$start" "$cache" || sim_rc=$?
-      echo "$sim_rc" > "$cell/simulate_rc.txt"
-      for mode in $MODES; do
-        run="$cell/$mode"
-        if [ -n "${BENCH_RESUME:-}" ] && [ -f "$run/rc.txt" ]; then continue; fi
-        rm -rf "$run"
-        mkdir -p "$run"
-        if [ "$sim_rc" -ne 0 ]; then
-          echo "simulate $sim_rc" > "$run/rc.txt"
-          continue
-        fi
-        echo "bench: $style seed $seed $mode" >&2
-        noise_set=()
-        if [ -n "$NOISE_K" ]; then
-          while read -r kv; do noise_set+=(--set "$kv"); done < <(truth_noise_set "$cache" "$NOISE_K")
-          [ "${#noise_set[@]}" -eq 8 ] || { echo "bench: no IMU noise in $cache/sim.yaml" >&2; exit 2; }
-        fi
-        run_rc=0
-        "$GVIO" run --dataset "$cache" --gnss off --set "vio.mode=$mode" --set map.enabled=false \
-          --set loops.enabled=false ${noise_set[@]+"${noise_set[@]}"} ${RUN_SET[@]+"${RUN_SET[@]}"} \
-          --out "$run" --no-progress \
-          > "$run/run.log" 2>&1 || run_rc=$?
-        eval_rc=-1
-        if [ "$run_rc" -eq 0 ] && [ -s "$run/trajectory_vio.tum" ]; then
-          eval_rc=0
-          "$GVIO" eval --ref "$cache/groundtruth.tum" --est "$run/trajectory_vio.tum" --align se3 \
-            --json "$run/eval.json" > "$run/eval.log" 2>&1 || eval_rc=$?
-        fi
-        echo "run $run_rc eval $eval_rc" > "$run/rc.txt"
-      done
-    done
-  done
-fi
+for_each_cell run_cell
 
 if [ -n "$NOISE_K" ]; then
   echo "estimator's IMU noise: each drive's own (sim.yaml) x $NOISE_K (BENCH_IMU_NOISE)"
