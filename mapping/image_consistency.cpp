@@ -5,17 +5,15 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
-#include "mapping/consistency.hpp"
 #include "odometry/error.hpp"
 
 namespace gvio::mapping {
 namespace {
-
-// 1.4826 MAD is the standard deviation of a normal distribution (Rousseeuw & Croux 1993).
-constexpr double kMadToSigma = 1.4826;
 
 void requireSameSize(const cv::Mat& m, const cv::Mat& ref, int type, const char* name) {
   if (m.size() != ref.size() || m.type() != type) {
@@ -24,81 +22,66 @@ void requireSameSize(const cv::Mat& m, const cv::Mat& ref, int type, const char*
   }
 }
 
-// The median (mapping::percentile's), NaN without values.
-double median(std::vector<double> v) {
-  return v.empty() ? std::numeric_limits<double>::quiet_NaN() : percentile(v, 0.5);
-}
-
-std::vector<double> finiteOf(const std::vector<double>& values) {
-  std::vector<double> finite;
-  for (const double v : values) {
-    if (std::isfinite(v)) finite.push_back(v);
-  }
-  return finite;
-}
-
-double robustSigma(const std::vector<double>& values, double m, double floor) {
-  std::vector<double> dev;
-  dev.reserve(values.size());
-  for (const double v : values) dev.push_back(std::abs(v - m));
-  return std::max(kMadToSigma * median(dev), floor);
-}
-
-// The global and the per-view local thresholds of one score (NaN: not scored).
-ScoreThresholds thresholdsOf(const std::vector<double>& values, const std::vector<double>& t_s,
-                             double floor, const ImageConsistencyConfig& c) {
-  ScoreThresholds out;
-  out.global = floor;
-  const double inf = std::numeric_limits<double>::infinity();
-  out.local.assign(values.size(), -inf);
-  const std::vector<double> finite = finiteOf(values);
-  out.median = median(finite);
-  if (finite.size() < c.min_views_to_flag) return out;
-  out.global = std::max(
-      floor, out.median - c.flag_sigmas * robustSigma(finite, out.median, c.min_flag_sigma));
-  // Local medians over +-window/2 (two pointers: the times ascend), then the residuals' spread.
-  std::vector<double> local_median(values.size(), std::numeric_limits<double>::quiet_NaN());
-  std::vector<double> residuals;
-  std::size_t lo = 0, hi = 0;
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    while (t_s[lo] < t_s[i] - 0.5 * c.local_window_s) ++lo;
-    while (hi < values.size() && t_s[hi] <= t_s[i] + 0.5 * c.local_window_s) ++hi;
-    std::vector<double> window;
-    for (std::size_t j = lo; j < hi; ++j) {
-      if (std::isfinite(values[j])) window.push_back(values[j]);
-    }
-    if (window.size() < c.min_views_to_flag || !std::isfinite(values[i])) continue;
-    local_median[i] = median(window);
-    residuals.push_back(values[i] - local_median[i]);
-  }
-  if (residuals.size() < c.min_views_to_flag) return out;
-  const double sigma = robustSigma(residuals, median(residuals), c.min_flag_sigma);
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    if (std::isfinite(local_median[i])) out.local[i] = local_median[i] - c.flag_sigmas * sigma;
-  }
-  return out;
-}
-
-double depthAgreement(const cv::Mat& rendered_depth, const cv::Mat& stereo_depth, double fb,
-                      const ImageConsistencyConfig& c, std::size_t& pixels) {
-  std::size_t agree = 0;
-  pixels = 0;
-  for (int y = 0; y < rendered_depth.rows; ++y) {
-    const float* r = rendered_depth.ptr<float>(y);
-    const float* s = stereo_depth.ptr<float>(y);
-    for (int x = 0; x < rendered_depth.cols; ++x) {
-      if (!(r[x] > 0.0F) || !(s[x] > 0.0F) || !std::isfinite(r[x]) || !std::isfinite(s[x])) {
-        continue;
+// Depth agreement over the patch grid: the share of agreeing pixels over the cells holding at
+// least min_cell_depth_pixels pixels with both depths, and its standard error as a ratio estimator
+// over those cells (Cochran 1977, sec. 6.4, cluster sampling):
+// se^2 = m / (m - 1) sum_c (a_c - p n_c)^2 / N^2, for m cells of n_c pixels, a_c agreeing.
+void scoreDepth(const cv::Mat& rendered_depth, const cv::Mat& stereo_depth, double fb,
+                const ImageConsistencyConfig& c, ViewScore& score) {
+  const int p = c.patch_px;
+  std::vector<std::pair<std::size_t, std::size_t>> cells;  // (agreeing, pixels)
+  for (int y0 = 0; y0 + p <= rendered_depth.rows; y0 += p) {
+    for (int x0 = 0; x0 + p <= rendered_depth.cols; x0 += p) {
+      std::size_t agree = 0, pixels = 0;
+      for (int y = y0; y < y0 + p; ++y) {
+        const float* r = rendered_depth.ptr<float>(y);
+        const float* s = stereo_depth.ptr<float>(y);
+        for (int x = x0; x < x0 + p; ++x) {
+          if (!(r[x] > 0.0F) || !(s[x] > 0.0F) || !std::isfinite(r[x]) || !std::isfinite(s[x])) {
+            continue;
+          }
+          ++pixels;
+          const double zs = s[x];
+          if (std::abs(static_cast<double>(r[x]) - zs) <= depthTolerance(zs, fb, c)) ++agree;
+        }
       }
-      ++pixels;
-      const double zs = s[x];
-      if (std::abs(static_cast<double>(r[x]) - zs) <= depthTolerance(zs, fb, c)) ++agree;
+      if (pixels >= static_cast<std::size_t>(c.min_cell_depth_pixels)) {
+        cells.emplace_back(agree, pixels);
+      }
     }
   }
-  if (pixels < static_cast<std::size_t>(c.min_depth_pixels)) {
-    return std::numeric_limits<double>::quiet_NaN();
+  std::size_t agree = 0, pixels = 0;
+  for (const auto& [a, n] : cells) {
+    agree += a;
+    pixels += n;
   }
-  return static_cast<double>(agree) / static_cast<double>(pixels);
+  score.depth_cells = static_cast<int>(cells.size());
+  score.depth_pixels = pixels;
+  if (score.depth_cells < c.min_depth_cells) return;
+  const double share = static_cast<double>(agree) / static_cast<double>(pixels);
+  double sum = 0.0;
+  for (const auto& [a, n] : cells) {
+    const double dev = static_cast<double>(a) - share * static_cast<double>(n);
+    sum += dev * dev;
+  }
+  const auto m = static_cast<double>(cells.size());
+  score.depth_agreement = share;
+  score.depth_se = std::sqrt(m / (m - 1.0) * sum) / static_cast<double>(pixels);
+}
+
+// The mean of the patch ZNCCs and its standard error (sample spread / sqrt(n)).
+void scoreNcc(const std::vector<double>& patch_ncc, const ImageConsistencyConfig& c,
+              ViewScore& score) {
+  score.patches = static_cast<int>(patch_ncc.size());
+  if (score.patches < c.min_patches || score.patches < 2) return;
+  double sum = 0.0;
+  for (const double z : patch_ncc) sum += z;
+  const double n = static_cast<double>(patch_ncc.size());
+  const double mean = sum / n;
+  double ss = 0.0;
+  for (const double z : patch_ncc) ss += (z - mean) * (z - mean);
+  score.ncc = mean;
+  score.ncc_se = std::sqrt(ss / (n - 1.0) / n);
 }
 
 }  // namespace
@@ -121,19 +104,17 @@ void ImageConsistencyConfig::validate() const {
     fail("disparity_tolerance_px must be >= 0");
   }
   if (min_patches < 1) fail("min_patches must be >= 1");
-  if (min_depth_pixels < 1) fail("min_depth_pixels must be >= 1");
+  if (min_cell_depth_pixels < 1) fail("min_cell_depth_pixels must be >= 1");
+  if (min_depth_cells < 2) fail("min_depth_cells must be >= 2");
   if (!(flag_sigmas > 0.0) || !std::isfinite(flag_sigmas)) fail("flag_sigmas must be > 0");
+  if (!(depth_flag_sigmas > 0.0) || !std::isfinite(depth_flag_sigmas)) {
+    fail("depth_flag_sigmas must be > 0");
+  }
   if (!(min_flag_sigma > 0.0) || !std::isfinite(min_flag_sigma)) {
     fail("min_flag_sigma must be > 0");
   }
   if (min_views_to_flag < 3) fail("min_views_to_flag must be >= 3");
   if (!(min_ncc >= -1.0 && min_ncc <= 1.0)) fail("min_ncc must be in [-1, 1]");
-  if (!(min_depth_agreement >= 0.0 && min_depth_agreement <= 1.0)) {
-    fail("min_depth_agreement must be in [0, 1]");
-  }
-  if (!(min_relative_coverage >= 0.0) || !std::isfinite(min_relative_coverage)) {
-    fail("min_relative_coverage must be >= 0");
-  }
   if (!(local_window_s > 0.0) || !std::isfinite(local_window_s)) {
     fail("local_window_s must be > 0");
   }
@@ -191,69 +172,19 @@ ViewScore scoreView(const cv::Mat& recorded, const cv::Mat& rendered, const cv::
       static_cast<double>(cv::countNonZero(covered)) / static_cast<double>(recorded.total());
   const int p = c.patch_px;
   const double min_covered = c.min_patch_coverage * p * p;
-  double sum = 0.0;
+  std::vector<double> patch_ncc;
   for (int y = 0; y + p <= recorded.rows; y += p) {
     for (int x = 0; x + p <= recorded.cols; x += p) {
       const cv::Rect r(x, y, p, p);
       const cv::Mat mask = covered(r);
       if (cv::countNonZero(mask) < min_covered) continue;
       const double z = maskedZncc(recorded(r), rendered(r), mask, c.min_patch_stddev);
-      if (!std::isfinite(z)) continue;
-      sum += z;
-      ++score.patches;
+      if (std::isfinite(z)) patch_ncc.push_back(z);
     }
   }
-  if (score.patches >= c.min_patches) score.ncc = sum / score.patches;
-  score.depth_agreement =
-      depthAgreement(rendered_depth_m, stereo_depth_m, focal_baseline_px_m, c, score.depth_pixels);
+  scoreNcc(patch_ncc, c, score);
+  scoreDepth(rendered_depth_m, stereo_depth_m, focal_baseline_px_m, c, score);
   return score;
-}
-
-FlaggedViews flagOutliers(const std::vector<ViewScore>& views, const std::vector<double>& t_s,
-                          const ImageConsistencyConfig& c) {
-  if (t_s.size() != views.size()) {
-    throw InvalidInput("image consistency: one time per view needed");
-  }
-  if (!std::is_sorted(t_s.begin(), t_s.end())) {
-    throw InvalidInput("image consistency: view times must ascend");
-  }
-  std::vector<double> ncc, depth;
-  for (const ViewScore& v : views) {
-    ncc.push_back(v.ncc);
-    depth.push_back(v.depth_agreement);
-  }
-  FlaggedViews out;
-  out.ncc = thresholdsOf(ncc, t_s, c.min_ncc, c);
-  out.depth.median = median(finiteOf(depth));
-  out.depth.global = c.min_depth_agreement;  // the floor only (see the config)
-  out.depth.local.assign(views.size(), -std::numeric_limits<double>::infinity());
-  out.flagged.resize(views.size(), false);
-  std::vector<double> coverage;
-  for (const ViewScore& v : views) coverage.push_back(v.coverage);
-  const double typical_coverage = median(coverage);
-  for (std::size_t i = 0; i < views.size(); ++i) {
-    const bool comparable = views[i].coverage >= c.min_relative_coverage * typical_coverage;
-    const auto below = [&](double v, const ScoreThresholds& th, double floor) {
-      if (!std::isfinite(v)) return false;
-      return v < floor || (comparable && (v < th.global || v < th.local[i]));
-    };
-    out.flagged[i] =
-        below(ncc[i], out.ncc, c.min_ncc) || below(depth[i], out.depth, c.min_depth_agreement);
-  }
-  return out;
-}
-
-std::vector<ViewStretch> flaggedStretches(const std::vector<bool>& flagged, std::size_t max_gap) {
-  std::vector<ViewStretch> out;
-  for (std::size_t i = 0; i < flagged.size(); ++i) {
-    if (!flagged[i]) continue;
-    if (!out.empty() && i - out.back().last <= max_gap + 1) {
-      out.back().last = i;
-    } else {
-      out.push_back({i, i});
-    }
-  }
-  return out;
 }
 
 }  // namespace gvio::mapping

@@ -10,10 +10,8 @@
 //    depths agree, compared as disparities d = f b / z (stereo's error is uniform in disparity,
 //    Hartley & Zisserman 2003, sec. 12.6): |f b / z_r - f b / z_s| <= tolerance, i.e. a depth
 //    tolerance of about z^2 tolerance / (f b), plus a floor of one voxel.
-// Both are summarised per view; flagOutliers() marks the views far below the agreement typical of
-// their stretch of the drive (how well a correct map matches its image varies with the world's
-// texture and depth, slowly along a drive), or far below the whole drive's, so a fault stands
-// out whatever the world looks like.
+// Both are means over a grid of patches, with standard errors from the patches' spread; which
+// views they flag is mapping/view_flags.hpp's.
 // No file I/O.
 #include <cstddef>
 #include <limits>
@@ -31,43 +29,53 @@ struct ImageConsistencyConfig {
   // Disparity tolerance in the pixels of scoreView's focal_baseline_px_m = f b (SGBM's downscaled
   // image): 1 px is about three sigmas of the difference of two SGBM disparities (each with
   // SGBM's ~1/4 px sub-pixel error, plus the 0.1 m voxels), i.e. 0.52 m at 10 m on KITTI at half
-  // size (f b = 194 px m). On the simulated demo drive with true poses 88 % of the pixels agree
-  // (0.5 px: 62 %, too close to the noise to tell a fault from it).
+  // size (f b = 194 px m).
   double disparity_tolerance_px = 1.0;
   double depth_tolerance_m = 0.1;  // never tighter than this (one voxel of the map)
-  int min_patches = 10;            // fewer valid patches: the view's ZNCC is not scored
-  int min_depth_pixels = 500;      // fewer pixels with both depths: no depth agreement
-  // A view is flagged when its ZNCC falls below the median of the views within +-local_window_s/2
-  // by more than flag_sigmas robust sigmas of all such differences (1.4826 MAD), or below the
-  // median of the whole drive by more than flag_sigmas robust sigmas of its ZNCCs. A sigma is
-  // never below min_flag_sigma (a drive whose views all agree equally would flag noise). 10 s:
-  // several times a fault's few seconds, short against a change of scenery.
+
+  // The evidence a score needs. Both scores are means over the patch grid, so each has a standard
+  // error from the spread of its patches: ZNCC over the textured patches the drawing covers, depth
+  // agreement over the patches holding at least min_cell_depth_pixels pixels with both depths
+  // (pixels of one SGBM block are not independent, patches nearly are). Fewer patches than these
+  // minimums: "not enough evidence", never a flag.
+  int min_patches = 10;
+  int min_cell_depth_pixels = 32;
+  int min_depth_cells = 10;
+
+  // The flag rule (flagOutliers), the same for both scores. A view's score s is compared with the
+  // median m of the views within +-local_window_s/2 (the scenery changes slowly along a drive), or
+  // with the whole drive's median where fewer than min_views_to_flag views are that near. Its
+  // residual s - m is judged against its own standard error se and the spread tau that correct
+  // views show around their neighbours beyond their errors (estimated from the drive:
+  // tau^2 = (1.4826 MAD of the residuals)^2 - median se^2). A view is flagged when
+  // (s - m) / sqrt(tau^2 + se^2) < -k x the robust spread of these standardised residuals over the
+  // drive (at least 1): a normal score flags Phi(-k) of correct views, 3e-5 at k = 4; the benchmark
+  // measures the rate on each world (tests/bench/image_check_matrix.sh). k is flag_sigmas for the
+  // ZNCC and depth_flag_sigmas for the depth agreement, whose residuals have heavier tails (a
+  // share of pixels of whole surfaces: a parked car or a turn moves many at once). min_flag_sigma
+  // keeps a drive whose views all agree alike from flagging noise.
   double local_window_s = 10.0;
   double flag_sigmas = 4.0;
-  double min_flag_sigma = 0.03;
-  // And whatever the drive: a map that does not correlate with its image (ZNCC near 0) or whose
-  // depth disagrees on most pixels is wrong there. These floors catch a fault long enough to move
-  // the medians; they sit below a correct map's scores (simulated KITTI-00 with true poses: ZNCC
-  // 0.33-0.69, depth agreement 0.39-0.98).
-  // The depth agreement flags through its floor only: with true poses it dips by 4 robust sigmas
-  // at turns and near objects (27 KITTI-00 keyframes flagged, all on depth alone), while every
-  // fault seen (poses moved, the VIO's errors) lowered the ZNCC first.
-  double min_ncc = 0.15;
-  double min_depth_agreement = 0.3;
+  double depth_flag_sigmas = 5.0;
+  double min_flag_sigma = 0.02;
   std::size_t min_views_to_flag = 8;
-  // A view the render covers much less than is typical of the drive (the first and last keyframes
-  // see the map from one side only; a turn into an unmapped street) scores lower with a correct
-  // map, since its patches are sparser and fewer: it is flagged by the floors only.
-  double min_relative_coverage = 0.75;  // too few views for a robust spread: nothing is flagged
+  // Whatever the drive: a map that does not correlate with its image (ZNCC significantly below
+  // min_ncc: s + flag_sigmas x se < min_ncc) is wrong there. Depth agreement has no such floor: its
+  // level depends on how well SGBM matches the world's surfaces.
+  double min_ncc = 0.15;
 
   void validate() const;  // throws InvalidInput naming the field
 };
 
 struct ViewScore {
-  double ncc = std::numeric_limits<double>::quiet_NaN();  // mean patch ZNCC, NaN: not scored
-  int patches = 0;                                        // patches that counted
-  double coverage = 0.0;                                  // share of the image the render covers
-  double depth_agreement = std::numeric_limits<double>::quiet_NaN();  // NaN: not scored
+  double ncc = std::numeric_limits<double>::quiet_NaN();     // mean patch ZNCC, NaN: not scored
+  double ncc_se = std::numeric_limits<double>::quiet_NaN();  // its standard error
+  int patches = 0;                                           // patches that counted
+  double coverage = 0.0;                                     // share of the image the render covers
+  // Share of the pixels with both depths that agree; NaN: not scored.
+  double depth_agreement = std::numeric_limits<double>::quiet_NaN();
+  double depth_se = std::numeric_limits<double>::quiet_NaN();  // its standard error
+  int depth_cells = 0;           // patches with enough pixels of both depths
   std::size_t depth_pixels = 0;  // pixels with a rendered and a stereo depth
 
   [[nodiscard]] bool hasNcc() const { return ncc == ncc; }
@@ -91,30 +99,5 @@ struct ViewScore {
 // standard deviation below min_stddev or fewer than 2 pixels count.
 [[nodiscard]] double maskedZncc(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask,
                                 double min_stddev);
-
-// The flag thresholds of one score.
-struct ScoreThresholds {
-  double median = std::numeric_limits<double>::quiet_NaN();  // of the whole drive
-  double global = -std::numeric_limits<double>::infinity();  // flagged below (at least the floor)
-  std::vector<double> local;  // per view: flagged below (-inf where there are too few views)
-};
-
-struct FlaggedViews {
-  std::vector<bool> flagged;  // per view
-  ScoreThresholds ncc, depth;
-};
-
-// t_s: the views' times (s), ascending. Unscored values never flag.
-[[nodiscard]] FlaggedViews flagOutliers(const std::vector<ViewScore>& views,
-                                        const std::vector<double>& t_s,
-                                        const ImageConsistencyConfig& config);
-
-struct ViewStretch {
-  std::size_t first = 0, last = 0;  // view indices, inclusive
-};
-
-// Runs of flagged views, joined across gaps of at most max_gap unflagged views.
-[[nodiscard]] std::vector<ViewStretch> flaggedStretches(const std::vector<bool>& flagged,
-                                                        std::size_t max_gap = 1);
 
 }  // namespace gvio::mapping

@@ -186,6 +186,15 @@ Command addConsistencyCommand(CLI::App& app, const CommonOptions& common) {
   sub->add_option("--worst", ic.worst_images,
                   "--images: side-by-side images of this many worst keyframes")
       ->capture_default_str();
+  sub->add_option("--flag-sigmas", ic.check.score.flag_sigmas,
+                  "--images: flag a keyframe whose ZNCC lies this many of its sigmas below what "
+                  "is typical of its stretch of the drive")
+      ->capture_default_str();
+  sub->add_option("--depth-flag-sigmas", ic.check.score.depth_flag_sigmas,
+                  "--images: ... whose depth agreement lies this many sigmas below")
+      ->capture_default_str();
+  sub->add_flag("--no-revisits", ic.no_revisits,
+                "--images: do not check keyframes at revisits against the other passes' map");
   sub->add_option("--json", o->json, "Write the metrics as JSON");
   sub->add_option("--reference-origin", o->reference_origin,
                   "Merged maps (gvio merge): the mesh's local ENU origin lat,lon,h (default: the "

@@ -22,6 +22,7 @@ struct ImageConsistencyRequest {
   std::optional<double> at_s;                    // only the keyframe nearest this time
   std::optional<double> from_s, to_s;            // only keyframes in [from, to] s into the drive
   std::size_t worst_images = 3;
+  bool no_revisits = false;  // --no-revisits: check.revisits off
   viz::ImageCheckOptions check;
   ProgressStyle progress = ProgressStyle::kOff;
 };

@@ -60,6 +60,9 @@ void ImageCheckOptions::validate() const {
     throw InvalidInput("the maximum view angle must be in (0, 180] degrees");
   }
   if (cache_keyframes < 1) throw InvalidInput("the keyframe cache must hold >= 1 keyframe");
+  if (!(min_self_depth_agreement >= 0.0 && min_self_depth_agreement <= 1.0)) {
+    throw InvalidInput("the self-check's minimum depth agreement must be in [0, 1]");
+  }
   score.validate();
 }
 
@@ -95,6 +98,11 @@ struct ImageCheck::State {
             cv::Mat& depth);
   cv::Mat stereoDepthImage(const mapping::CameraCloud& raw) const;
   std::vector<std::size_t> sourcesFor(std::size_t keyframe) const;
+  std::vector<std::size_t> otherPasses(std::size_t keyframe,
+                                       const std::vector<std::size_t>& sources) const;
+  mapping::ViewScore scoreAgainst(std::size_t k, const std::vector<std::size_t>& sources,
+                                  const cv::Mat& stereo_depth, CheckImages& drawn,
+                                  std::size_t& points_drawn);
 };
 
 void ImageCheck::State::selectKeyframes() {
@@ -199,6 +207,25 @@ std::vector<std::size_t> ImageCheck::State::sourcesFor(std::size_t k) const {
     const Eigen::Vector3d mid_j = c_j + 0.5 * reach * other.T_map_c.linear().col(2);
     if ((mid_j - c_k).dot(fwd_k) < -reach) continue;
     out.push_back(j);
+  }
+  return out;
+}
+
+// The sources not on the keyframe's own pass: its pass is the run of consecutive keyframes around
+// it that all stay within the neighbour radius of it (a car stopped at a light has no keyframes
+// while it stands, so the keyframes before and after the stop are one pass).
+std::vector<std::size_t> ImageCheck::State::otherPasses(
+    std::size_t k, const std::vector<std::size_t>& sources) const {
+  const Eigen::Vector3d c_k = keyframes[k].T_map_c.translation();
+  const auto near = [&](std::size_t j) {
+    return (keyframes[j].T_map_c.translation() - c_k).norm() <= options.neighbour_radius_m;
+  };
+  std::size_t first = k, last = k;
+  while (first > 0 && near(first - 1)) --first;
+  while (last + 1 < keyframes.size() && near(last + 1)) ++last;
+  std::vector<std::size_t> out;
+  for (const std::size_t j : sources) {
+    if (j < first || j > last) out.push_back(j);
   }
   return out;
 }
@@ -323,29 +350,59 @@ void ImageCheck::State::draw(render::PointCloud points, const render::RenderCame
   }
 }
 
+// The map of `sources` drawn from keyframe k and scored against its image and stereo depth.
+mapping::ViewScore ImageCheck::State::scoreAgainst(std::size_t k,
+                                                   const std::vector<std::size_t>& sources,
+                                                   const cv::Mat& stereo_depth, CheckImages& drawn,
+                                                   std::size_t& points_drawn) {
+  render::PointCloud points = pointsInView(k, sources);
+  points_drawn = points.points.size();
+  cv::Mat rendered_depth;
+  draw(std::move(points), render::pinholeCamera(K, keyframes[k].T_map_c), drawn, rendered_depth);
+  return mapping::scoreView(drawn.recorded, drawn.rendered, drawn.covered, rendered_depth,
+                            stereo_depth, focal_baseline_px_m, options.score);
+}
+
 CheckedView ImageCheck::check(std::size_t k, CheckImages* images) {
   State& s = *state_;
   const auto start = std::chrono::steady_clock::now();
   if (k >= s.keyframes.size()) throw InvalidInput("image check: keyframe index out of range");
   CheckImages drawn;
-  cv::Mat stereo_depth, rendered_depth;
+  cv::Mat stereo_depth;
   s.ownInputs(k, drawn.recorded, stereo_depth);
   const std::vector<std::size_t> sources = s.sourcesFor(k);
-  render::PointCloud points = s.pointsInView(k, sources);
   CheckedView view;
   view.keyframe = k;
   view.t_ns = s.keyframes[k].t_ns;
   view.source_keyframes = sources.size();
-  view.points_drawn = points.points.size();
-  s.draw(std::move(points), render::pinholeCamera(s.K, s.keyframes[k].T_map_c), drawn,
-         rendered_depth);
-  view.score = mapping::scoreView(drawn.recorded, drawn.rendered, drawn.covered, rendered_depth,
-                                  stereo_depth, s.focal_baseline_px_m, s.options.score);
+  if (s.options.revisits) {
+    const std::vector<std::size_t> others = s.otherPasses(k, sources);
+    view.revisit_sources = others.size();
+    if (!others.empty()) {
+      CheckImages revisit = drawn;
+      std::size_t points = 0;
+      view.revisit = s.scoreAgainst(k, others, stereo_depth, revisit, points);
+    }
+  }
+  view.score = s.scoreAgainst(k, sources, stereo_depth, drawn, view.points_drawn);
   if (images != nullptr) *images = drawn;
   s.trimCache();
   view.ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return view;
+}
+
+mapping::ViewScore ImageCheck::selfCheck(std::size_t k) {
+  State& s = *state_;
+  if (k >= s.keyframes.size()) throw InvalidInput("image check: keyframe index out of range");
+  CheckImages drawn;
+  const mapping::CameraCloud own = s.stereoPoints(s.keyframes[k].frame, &drawn.recorded);
+  const cv::Mat stereo_depth = s.stereoDepthImage(own);
+  s.remember(k, own);
+  std::size_t points = 0;
+  const mapping::ViewScore score = s.scoreAgainst(k, {k}, stereo_depth, drawn, points);
+  s.trimCache();
+  return score;
 }
 
 cv::Mat sideBySide(const CheckImages& im) {

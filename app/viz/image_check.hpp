@@ -49,6 +49,17 @@ struct ImageCheckOptions {
   double max_depth_m = 40.0;          // points farther from the camera are not drawn
   double splat_m = 0.1;               // a point is a disc of this size (the map's voxel), 1.5-12 px
   std::size_t cache_keyframes = 400;  // keyframe clouds kept (~0.4 MB each on KITTI)
+  // At a revisit (a loop, a second pass), the keyframe is also checked against the map of the
+  // other passes alone: the keyframes that are near it but not on its own pass, i.e. not joined to
+  // it by consecutive keyframes all within neighbour_radius_m of it. No exclusion window is
+  // needed there, and two passes agreeing is the strongest test of a map's consistency.
+  bool revisits = true;
+  // A few keyframes' own points are drawn from their own poses first (ImageCheck::selfCheck):
+  // their depth agreement is what a perfectly consistent map reaches on this dataset. Below this
+  // median, the drawn and the stereo depths are not comparable here, and the depth score is
+  // reported as not enough evidence instead of flagging every keyframe.
+  std::size_t self_check_keyframes = 5;
+  double min_self_depth_agreement = 0.8;
   mapping::ImageConsistencyConfig score;
 
   void validate() const;  // InvalidInput naming the option
@@ -66,7 +77,11 @@ struct CheckedView {
   std::size_t source_keyframes = 0;  // keyframes whose points were drawn
   std::size_t points_drawn = 0;
   mapping::ViewScore score;
-  double ms = 0.0;  // wall time of this check (stereo of new keyframes, render, scores)
+  // Against the other passes' map alone (ImageCheckOptions::revisits); revisit_sources == 0: the
+  // keyframe has no other pass near it, and revisit is not scored.
+  std::size_t revisit_sources = 0;
+  mapping::ViewScore revisit;
+  double ms = 0.0;  // wall time of this check (stereo of new keyframes, renders, scores)
 };
 
 // The images of one check, for the side-by-side picture.
@@ -91,6 +106,11 @@ class ImageCheck {
   [[nodiscard]] std::size_t keyframeNearest(std::int64_t t_ns) const;
   // Checks one keyframe; `images` gets its images when given.
   [[nodiscard]] CheckedView check(std::size_t keyframe, CheckImages* images = nullptr);
+  // The keyframe's own points drawn from its own pose and scored against its own image and depth:
+  // what a perfectly consistent map scores on this dataset. Far below 1, the comparison itself is
+  // invalid here (a calibration or rectification the rendering does not share), whatever the
+  // map. Call after the sweep of check() calls: it computes the keyframe's stereo again.
+  [[nodiscard]] mapping::ViewScore selfCheck(std::size_t keyframe);
 
  private:
   struct State;

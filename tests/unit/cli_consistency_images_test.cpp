@@ -10,11 +10,11 @@
 #include <cmath>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "support/fixtures.hpp"
+#include "support/image_check_runs.hpp"
 
 namespace gvio::test {
 namespace {
@@ -24,6 +24,7 @@ namespace fs = std::filesystem;
 struct CsvRow {
   double t_s = 0.0, ncc = 0.0, depth = 0.0;
   bool flagged = false;
+  std::string status, reason;
 };
 
 std::vector<CsvRow> readRows(const fs::path& csv) {
@@ -33,37 +34,19 @@ std::vector<CsvRow> readRows(const fs::path& csv) {
   EXPECT_EQ(line.rfind("t_s,t_from_start_s,x_m,y_m,z_m,ncc,ncc_flag_below,", 0), 0U) << line;
   std::vector<CsvRow> rows;
   while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::stringstream ss(line);
-    for (std::string cell; std::getline(ss, cell, ',');) f.push_back(cell);
-    EXPECT_EQ(f.size(), 16U) << line;
-    if (f.size() != 16U) continue;
-    rows.push_back({std::stod(f[1]), std::stod(f[5]), std::stod(f[9]), f[14] == "1"});
+    std::vector<std::string> f(1);  // a trailing empty field counts too
+    for (const char ch : line) {
+      if (ch == ',') {
+        f.emplace_back();
+      } else {
+        f.back() += ch;
+      }
+    }
+    EXPECT_EQ(f.size(), 28U) << line;
+    if (f.size() != 28U) continue;
+    rows.push_back({std::stod(f[1]), std::stod(f[5]), std::stod(f[9]), f[14] == "1", f[21], f[22]});
   }
   return rows;
-}
-
-// `trajectory` with its positions moved by `offset` between t0 and t1 s from its start.
-std::string displaced(const fs::path& tum, double t0, double t1, const Eigen::Vector3d& offset) {
-  std::ifstream in(tum);
-  std::ostringstream out;
-  std::string line;
-  double first = std::nan("");
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream ls(line);
-    double t = 0, x = 0, y = 0, z = 0, qx = 0, qy = 0, qz = 0, qw = 0;
-    ls >> t >> x >> y >> z >> qx >> qy >> qz >> qw;
-    if (std::isnan(first)) first = t;
-    if (t - first >= t0 && t - first < t1) {
-      x += offset.x();
-      y += offset.y();
-      z += offset.z();
-    }
-    out << fmt::format("{:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}\n", t, x, y, z, qx,
-                       qy, qz, qw);
-  }
-  return out.str();
 }
 
 // Each test runs in a process of its own (ctest), so each does only what it needs, once: the
@@ -87,15 +70,7 @@ class CliConsistencyImages : public ::testing::Test {
   }
   // A run folder of `trajectory_tum` (the text of a TUM file) over the simulated drive.
   static void makeRun(const std::string& name, const std::string& trajectory_tum) {
-    fs::create_directories(run(name));
-    const nlohmann::json r = {{"mode", "stereo-imu"},
-                              {"sources",
-                               {{"dataset", fs::absolute(dataset_).string()},
-                                {"format", "kitti-raw"},
-                                {"calib_files", nlohmann::json::array()},
-                                {"gnss_file", nullptr}}}};
-    writeText(run(name) / "report.json", r.dump(2));
-    writeText(run(name) / "trajectory.tum", trajectory_tum);
+    writeTrajectoryRun(run(name), dataset_, trajectory_tum);
   }
   static void check(const std::string& name) {
     if (fs::exists(report(name) / "summary.json")) return;
@@ -110,7 +85,7 @@ class CliConsistencyImages : public ::testing::Test {
   static void checkFault() {
     if (!fs::exists(run("fault"))) {
       makeRun("fault",
-              displaced(dataset_ / "groundtruth.tum", kFaultFrom, kFaultTo, {0.0, 0.5, 0.0}));
+              displacedTum(dataset_ / "groundtruth.tum", kFaultFrom, kFaultTo, {0.0, 0.5, 0.0}));
     }
     check("fault");
   }
@@ -150,6 +125,9 @@ TEST_F(CliConsistencyImages, TheTruePosesAreFlaggedNowhere) {
   EXPECT_GT(s["ms_per_keyframe"]["mean"].get<double>(), 0.0);
   EXPECT_EQ(s["keyframes"]["flagged"].get<int>(), 0);
   EXPECT_TRUE(s["flagged_stretches"].empty());
+  EXPECT_TRUE(s["flags"].empty());
+  EXPECT_EQ(s["revisits"]["keyframes"].get<int>(), 0);  // a drive that never comes back
+  EXPECT_GT(s["flag_rule"]["ncc_normal_false_alarm_rate"].get<double>(), 0.0);
   EXPECT_GT(s["ncc"]["mean"].get<double>(), 0.5);
   EXPECT_GT(s["depth_agreement"]["mean"].get<double>(), 0.8);
 }
@@ -163,8 +141,13 @@ TEST_F(CliConsistencyImages, PosesMovedHalfAMetreAreFlaggedAtThatStretchOnly) {
   const auto rows = readRows(report("fault") / "keyframes.csv");
   std::size_t flagged = 0;
   for (const CsvRow& r : rows) {
-    if (!r.flagged) continue;
+    if (!r.flagged) {
+      EXPECT_NE(r.status, "flagged");
+      continue;
+    }
     ++flagged;
+    EXPECT_EQ(r.status, "flagged");
+    EXPECT_THAT(r.reason, HasSubstr(" over "));  // the score, its threshold and its support
     EXPECT_GE(r.t_s, kFaultFrom - 5.0) << "flagged before the stretch could be seen";
     EXPECT_LE(r.t_s, kFaultTo + 1.0) << "flagged after the stretch";
   }

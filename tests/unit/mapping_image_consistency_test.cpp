@@ -1,5 +1,6 @@
 // mapping/image_consistency: the scores of a rendered map against a recorded image and stereo
 // depth, and the robust flagging of the views that disagree (issue 19's per-keyframe check).
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <random>
 
 #include "mapping/image_consistency.hpp"
+#include "mapping/view_flags.hpp"
 #include "odometry/error.hpp"
 
 namespace gvio::mapping {
@@ -74,6 +76,7 @@ TEST(ImageConsistency, ARenderInPlaceScoresHighAndAShiftedOneLow) {
   const Views same = sameView();
   const ViewScore good = score(same);
   EXPECT_NEAR(good.ncc, 1.0, 1e-9);
+  EXPECT_NEAR(good.ncc_se, 0.0, 1e-9);  // every patch agrees alike
   EXPECT_EQ(good.patches, (320 / 16) * (160 / 16));
   EXPECT_DOUBLE_EQ(good.coverage, 1.0);
   EXPECT_DOUBLE_EQ(good.depth_agreement, 1.0);
@@ -94,7 +97,9 @@ TEST(ImageConsistency, DepthAgreesWithinOneDisparityPixel) {
   EXPECT_DOUBLE_EQ(score(v).depth_agreement, 1.0);
   v.rendered_depth(cv::Rect(0, 0, 160, 160)).setTo(11.0F);  // half the image 1 m too deep
   EXPECT_NEAR(score(v).depth_agreement, 0.5, 1e-12);
-  v.stereo_depth.setTo(0.0F);  // no stereo depth: not scored
+  EXPECT_EQ(score(v).depth_cells, (320 / 16) * (160 / 16));
+  EXPECT_GT(score(v).depth_se, 0.0);  // agreeing and disagreeing patches
+  v.stereo_depth.setTo(0.0F);         // no stereo depth: not scored
   EXPECT_TRUE(std::isnan(score(v).depth_agreement));
   EXPECT_EQ(score(v).depth_pixels, 0U);
 }
@@ -152,17 +157,26 @@ std::vector<double> times(std::size_t n) {
 TEST(ImageConsistency, AShortDipIsFlaggedAndTheSceneryTrendIsNot) {
   const std::size_t n = 300;
   const FlaggedViews clean = flagOutliers(drive(n, 0.0, 0, 0), times(n), {});
-  for (std::size_t i = 0; i < n; ++i) EXPECT_FALSE(clean.flagged[i]) << i;
+  for (std::size_t i = 0; i < n; ++i) {
+    EXPECT_FALSE(clean.flagged[i]) << i;
+    EXPECT_EQ(clean.status[i], ViewStatus::kOk) << i;
+  }
   const FlaggedViews faulty = flagOutliers(drive(n, 0.25, 200, 210), times(n), {});
   for (std::size_t i = 0; i < n; ++i) {
     EXPECT_EQ(faulty.flagged[i], i >= 200 && i < 210) << i;
   }
+  // The flag says which score, against which threshold, on how much support.
+  EXPECT_THAT(faulty.reason[205], testing::HasSubstr("ncc "));
+  EXPECT_THAT(faulty.reason[205], testing::HasSubstr("local median"));
+  EXPECT_THAT(faulty.reason[205], testing::HasSubstr("over 0 patches"));
+  EXPECT_LT(faulty.ncc.z[205], -4.0);
+  EXPECT_TRUE(faulty.reason[100].empty());
   const auto stretches = flaggedStretches(faulty.flagged);
   ASSERT_EQ(stretches.size(), 1U);
   EXPECT_EQ(stretches[0].first, 200U);
   EXPECT_EQ(stretches[0].last, 209U);
-  // A long bad stretch moves the local medians with it, and the drive's spread with them; the
-  // floor (ZNCC 0.15) still flags a map that does not correlate with its images.
+  // A long bad stretch moves the local medians with it; the floor (ZNCC 0.15) still flags a map
+  // that does not correlate with its images.
   const FlaggedViews long_fault = flagOutliers(drive(n, 0.6, 100, 170), times(n), {});
   for (std::size_t i = 110; i < 160; ++i) EXPECT_TRUE(long_fault.flagged[i]) << i;
   for (std::size_t i = 180; i < n; ++i) EXPECT_FALSE(long_fault.flagged[i]) << i;
@@ -172,34 +186,59 @@ TEST(ImageConsistency, UnscoredViewsAndShortDrivesNeverFlag) {
   std::vector<ViewScore> views = drive(5, 0.5, 2, 3);
   views[2].ncc = 0.3;  // far below the others, but above the floor
   const FlaggedViews few = flagOutliers(views, times(5), {});
-  for (const bool f : few.flagged) EXPECT_FALSE(f);  // below min_views_to_flag
+  for (std::size_t i = 0; i < 5; ++i) {
+    EXPECT_FALSE(few.flagged[i]);  // below min_views_to_flag: nothing is typical yet
+    EXPECT_EQ(few.status[i], ViewStatus::kNotEnoughEvidence);
+  }
   views[2].ncc = 0.1;
   EXPECT_TRUE(flagOutliers(views, times(5), {}).flagged[2]);  // the floor holds on any drive
+  views[2].ncc_se = 0.02;  // ... when the view's own error cannot lift it above the floor
+  EXPECT_FALSE(flagOutliers(views, times(5), {}).flagged[2]);
   views = drive(100, 0.0, 0, 0);
   views[50].ncc = kNan;
   views[50].depth_agreement = kNan;
-  EXPECT_FALSE(flagOutliers(views, times(100), {}).flagged[50]);
+  const FlaggedViews unscored = flagOutliers(views, times(100), {});
+  EXPECT_FALSE(unscored.flagged[50]);
+  EXPECT_EQ(unscored.status[50], ViewStatus::kNotEnoughEvidence);
+  EXPECT_STREQ(toString(unscored.status[50]), "not_enough_evidence");
   EXPECT_THROW((void)flagOutliers(views, times(99), {}), InvalidInput);
   std::vector<double> unsorted = times(100);
   std::swap(unsorted[3], unsorted[4]);
   EXPECT_THROW((void)flagOutliers(views, unsorted, {}), InvalidInput);
 }
 
-TEST(ImageConsistency, AThinlyCoveredViewIsFlaggedByTheFloorsOnly) {
+// A view with few patches (the first and last keyframes see the map from one side) has a large
+// standard error: the same dip flags it only when its error is small.
+TEST(ImageConsistency, AViewWithLittleSupportNeedsALargerDip) {
   std::vector<ViewScore> views = drive(100, 0.0, 0, 0);
-  views[99].ncc -= 0.25;  // the last keyframe: the map on one side only
-  views[99].coverage = 0.2;
+  views[99].ncc -= 0.25;
+  views[99].ncc_se = 0.1;
+  views[99].patches = 12;
   EXPECT_FALSE(flagOutliers(views, times(100), {}).flagged[99]);
-  views[99].ncc = 0.1;
-  EXPECT_TRUE(flagOutliers(views, times(100), {}).flagged[99]);
+  views[99].ncc_se = 0.01;
+  views[99].patches = 400;
+  const FlaggedViews f = flagOutliers(views, times(100), {});
+  EXPECT_TRUE(f.flagged[99]);
+  EXPECT_THAT(f.reason[99], testing::HasSubstr("over 400 patches"));
 }
 
-TEST(ImageConsistency, TheDepthAgreementFlagsBelowItsFloorOnly) {
+// How well stereo depths agree depends on the world's surfaces: a drive that agrees little
+// everywhere (a low-texture road) flags nothing for it; a dip against the drive's own level does.
+TEST(ImageConsistency, DepthAgreementIsJudgedAgainstTheDrivesOwnLevel) {
   std::vector<ViewScore> views = drive(100, 0.0, 0, 0);
-  views[40].depth_agreement = 0.5;  // far below the drive's 0.9, as at a turn with true poses
+  for (ViewScore& v : views) v.depth_agreement = std::max(0.0, v.depth_agreement - 0.85);
+  const FlaggedViews low = flagOutliers(views, times(100), {});
+  for (std::size_t i = 0; i < 100; ++i) EXPECT_FALSE(low.flagged[i]) << i;
+  views = drive(100, 0.0, 0, 0);
+  views[40].depth_agreement = 0.5;  // far below the drive's 0.9 +- 0.01
+  views[40].depth_se = 0.02;
+  views[40].depth_cells = 80;
+  const FlaggedViews dip = flagOutliers(views, times(100), {});
+  EXPECT_TRUE(dip.flagged[40]);
+  EXPECT_THAT(dip.reason[40], testing::HasSubstr("depth agreement 0.500 <"));
+  EXPECT_THAT(dip.reason[40], testing::HasSubstr("over 80 patches"));
+  views[40].depth_se = 0.15;  // a few disagreeing patches: not evidence enough
   EXPECT_FALSE(flagOutliers(views, times(100), {}).flagged[40]);
-  views[40].depth_agreement = 0.2;
-  EXPECT_TRUE(flagOutliers(views, times(100), {}).flagged[40]);
 }
 
 TEST(ImageConsistency, StretchesJoinAcrossOneUnflaggedView) {

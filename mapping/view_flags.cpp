@@ -1,0 +1,224 @@
+#include "mapping/view_flags.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "mapping/consistency.hpp"
+#include "odometry/error.hpp"
+
+namespace gvio::mapping {
+namespace {
+
+// 1.4826 MAD is the standard deviation of a normal distribution (Rousseeuw & Croux 1993).
+constexpr double kMadToSigma = 1.4826;
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+// The median (mapping::percentile's), NaN without values.
+double median(std::vector<double> v) {
+  return v.empty() ? kNan : percentile(v, 0.5);
+}
+
+std::vector<double> finiteOf(const std::vector<double>& values) {
+  std::vector<double> finite;
+  for (const double v : values) {
+    if (std::isfinite(v)) finite.push_back(v);
+  }
+  return finite;
+}
+
+// 1.4826 MAD around the median of the finite values.
+double robustSpread(const std::vector<double>& values) {
+  const std::vector<double> finite = finiteOf(values);
+  if (finite.empty()) return kNan;
+  const double m = median(finite);
+  std::vector<double> dev;
+  dev.reserve(finite.size());
+  for (const double v : finite) dev.push_back(std::abs(v - m));
+  return kMadToSigma * median(dev);
+}
+
+// Per view: the median of the scored views within +-window/2 (two pointers: the times ascend);
+// NaN where the window holds fewer than min_views_to_flag.
+std::vector<double> localMedians(const std::vector<double>& values, const std::vector<double>& t_s,
+                                 const ImageConsistencyConfig& c) {
+  std::vector<double> out(values.size(), kNan);
+  std::size_t lo = 0, hi = 0;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    while (t_s[lo] < t_s[i] - 0.5 * c.local_window_s) ++lo;
+    while (hi < values.size() && t_s[hi] <= t_s[i] + 0.5 * c.local_window_s) ++hi;
+    std::vector<double> window;
+    for (std::size_t j = lo; j < hi; ++j) {
+      if (std::isfinite(values[j])) window.push_back(values[j]);
+    }
+    if (window.size() >= c.min_views_to_flag) out[i] = median(window);
+  }
+  return out;
+}
+
+// One comparison (with the local medians or the drive's): per view the scale of its residual,
+// d = max(sqrt(tau^2 + se^2), min_flag_sigma), the standardised residual z = (v - ref) / d, and
+// the robust spread of z over the drive (at least 1: a drive is never trusted to be tighter than
+// its own errors say).
+struct Comparison {
+  std::vector<double> d, z;
+  double tau = kNan, z_spread = kNan;
+};
+
+Comparison compare(const std::vector<double>& values, const std::vector<double>& se,
+                   const std::vector<double>& reference, const ImageConsistencyConfig& c) {
+  const std::size_t n = values.size();
+  Comparison out;
+  out.d.assign(n, kNan);
+  out.z.assign(n, kNan);
+  const auto error = [&](std::size_t i) { return std::isfinite(se[i]) ? se[i] : 0.0; };
+  std::vector<double> residuals, se2;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(values[i]) || !std::isfinite(reference[i])) continue;
+    residuals.push_back(values[i] - reference[i]);
+    se2.push_back(error(i) * error(i));
+  }
+  if (residuals.size() < c.min_views_to_flag) return out;
+  const double spread = robustSpread(residuals);
+  out.tau = std::sqrt(std::max(spread * spread - median(se2), 0.0));
+  std::vector<double> z;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(values[i]) || !std::isfinite(reference[i])) continue;
+    out.d[i] = std::max(std::hypot(out.tau, error(i)), c.min_flag_sigma);
+    out.z[i] = (values[i] - reference[i]) / out.d[i];
+    z.push_back(out.z[i]);
+  }
+  out.z_spread = std::max(1.0, robustSpread(z));
+  return out;
+}
+
+struct Score {
+  const char* name;  // "ncc", "depth agreement"
+  const char* unit;  // what its support counts
+  std::vector<double> value, se;
+  std::vector<int> support;
+  double k = 4.0;  // flagged this many sigmas below what is typical
+  double floor = -std::numeric_limits<double>::infinity();
+};
+
+// The thresholds of one score; `reason` gets, per view, why it is flagged ("" when it is not).
+ScoreThresholds thresholdsOf(const Score& s, const std::vector<double>& t_s,
+                             const ImageConsistencyConfig& c, std::vector<std::string>& reason) {
+  const std::size_t n = s.value.size();
+  ScoreThresholds out;
+  out.reference.assign(n, kNan);
+  out.below.assign(n, -std::numeric_limits<double>::infinity());
+  out.z.assign(n, kNan);
+  reason.assign(n, "");
+  out.median = median(finiteOf(s.value));
+  const Comparison local = compare(s.value, s.se, localMedians(s.value, t_s, c), c);
+  const Comparison drive = compare(s.value, s.se, std::vector<double>(n, out.median), c);
+  out.tau = local.tau;
+  out.z_spread = local.z_spread;
+  const double k = s.k;
+  const auto rule = [&](double below, double ref, double scale, const char* which) {
+    return fmt::format("{:.3f} = {} median {:.3f} - {:g} x {:.3f}", below, which, ref, k, scale);
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const double v = s.value[i];
+    if (!std::isfinite(v)) continue;
+    std::string why;
+    if (std::isfinite(local.z[i])) {
+      const double scale = local.z_spread * local.d[i];
+      out.reference[i] = v - local.z[i] * local.d[i];
+      out.z[i] = local.z[i] / local.z_spread;
+      out.below[i] = out.reference[i] - k * scale;
+      if (v < out.below[i]) why = rule(out.below[i], out.reference[i], scale, "local");
+    }
+    // The drive's median where the neighbours are too few to tell what is typical (a drive's
+    // ends with sparse keyframes): two tests on every view would double the false alarms.
+    if (!std::isfinite(local.z[i]) && std::isfinite(drive.z[i])) {
+      const double scale = drive.z_spread * drive.d[i];
+      out.reference[i] = out.median;
+      out.z[i] = drive.z[i] / drive.z_spread;
+      out.below[i] = out.median - k * scale;
+      if (v < out.below[i]) why = rule(out.below[i], out.median, scale, "drive");
+    }
+    const double e = std::isfinite(s.se[i]) ? s.se[i] : 0.0;
+    if (why.empty() && v + k * e < s.floor) {
+      why = fmt::format("{:.3f} = floor {:.3f} - {:g} x {:.3f}", s.floor - k * e, s.floor, k, e);
+    }
+    if (v + k * e < s.floor) out.below[i] = std::max(out.below[i], s.floor - k * e);
+    if (!why.empty()) {
+      reason[i] = fmt::format("{} {:.3f} < {} over {} {}", s.name, v, why, s.support[i], s.unit);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+const char* toString(ViewStatus status) {
+  switch (status) {
+    case ViewStatus::kOk:
+      return "ok";
+    case ViewStatus::kFlagged:
+      return "flagged";
+    case ViewStatus::kNotEnoughEvidence:
+      break;
+  }
+  return "not_enough_evidence";
+}
+
+FlaggedViews flagOutliers(const std::vector<ViewScore>& views, const std::vector<double>& t_s,
+                          const ImageConsistencyConfig& c) {
+  if (t_s.size() != views.size()) {
+    throw InvalidInput("image consistency: one time per view needed");
+  }
+  if (!std::is_sorted(t_s.begin(), t_s.end())) {
+    throw InvalidInput("image consistency: view times must ascend");
+  }
+  Score ncc{"ncc", "patches", {}, {}, {}, c.flag_sigmas, c.min_ncc};
+  Score depth{"depth agreement", "patches", {}, {}, {}, c.depth_flag_sigmas};
+  for (const ViewScore& v : views) {
+    ncc.value.push_back(v.ncc);
+    ncc.se.push_back(v.ncc_se);
+    ncc.support.push_back(v.patches);
+    depth.value.push_back(v.depth_agreement);
+    depth.se.push_back(v.depth_se);
+    depth.support.push_back(v.depth_cells);
+  }
+  FlaggedViews out;
+  std::vector<std::string> ncc_why, depth_why;
+  out.ncc = thresholdsOf(ncc, t_s, c, ncc_why);
+  out.depth = thresholdsOf(depth, t_s, c, depth_why);
+  const std::size_t n = views.size();
+  out.flagged.assign(n, false);
+  out.status.assign(n, ViewStatus::kNotEnoughEvidence);
+  out.reason.assign(n, "");
+  for (std::size_t i = 0; i < n; ++i) {
+    out.reason[i] = ncc_why[i];
+    if (!depth_why[i].empty()) {
+      out.reason[i] += (out.reason[i].empty() ? "" : "; ") + depth_why[i];
+    }
+    out.flagged[i] = !out.reason[i].empty();
+    const bool judged = std::isfinite(out.ncc.z[i]) || std::isfinite(out.depth.z[i]);
+    if (out.flagged[i]) {
+      out.status[i] = ViewStatus::kFlagged;
+    } else if (judged) {
+      out.status[i] = ViewStatus::kOk;
+    }
+  }
+  return out;
+}
+
+std::vector<ViewStretch> flaggedStretches(const std::vector<bool>& flagged, std::size_t max_gap) {
+  std::vector<ViewStretch> out;
+  for (std::size_t i = 0; i < flagged.size(); ++i) {
+    if (!flagged[i]) continue;
+    if (!out.empty() && i - out.back().last <= max_gap + 1) {
+      out.back().last = i;
+    } else {
+      out.push_back({i, i});
+    }
+  }
+  return out;
+}
+
+}  // namespace gvio::mapping
