@@ -197,6 +197,12 @@ TEST_F(CliConsistencyImages, OneKeyframeAtATimeAndBadRequests) {
   r = runGvio(fmt::format("consistency --run {} --images --exclude -1", quoted(run("truth"))));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr("--exclude"));
+  r = runGvio(fmt::format("consistency --run {} --images --flag-sigmas 0", quoted(run("truth"))));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("flag_sigmas must be > 0"));
+  r = runGvio(
+      fmt::format("consistency --run {} --images --depth-flag-sigmas nan", quoted(run("truth"))));
+  EXPECT_EQ(r.exit_code, 2);
   r = runGvio(fmt::format("consistency --run {} --images --dataset {}", quoted(run("truth")),
                           quoted(dir_->path() / "missing")));
   EXPECT_EQ(r.exit_code, 2);
