@@ -66,7 +66,12 @@ void scoreDepth(const cv::Mat& rendered_depth, const cv::Mat& stereo_depth, doub
   }
   const auto m = static_cast<double>(cells.size());
   score.depth_agreement = share;
-  score.depth_se = std::sqrt(m / (m - 1.0) * sum) / static_cast<double>(pixels);
+  // Never below a binomial share over m patches (Agresti & Coull 1998, two successes and two
+  // failures added): patches that all agree alike, or all disagree, measured on few patches are
+  // not known to +-0.
+  const double p_adjusted = (share * m + 2.0) / (m + 4.0);
+  const double binomial = std::sqrt(p_adjusted * (1.0 - p_adjusted) / m);
+  score.depth_se = std::max(std::sqrt(m / (m - 1.0) * sum) / static_cast<double>(pixels), binomial);
 }
 
 // The mean of the patch ZNCCs and its standard error (sample spread / sqrt(n)).

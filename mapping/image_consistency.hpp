@@ -77,6 +77,11 @@ struct ViewScore {
   double depth_se = std::numeric_limits<double>::quiet_NaN();  // its standard error
   int depth_cells = 0;           // patches with enough pixels of both depths
   std::size_t depth_pixels = 0;  // pixels with a rendered and a stereo depth
+  // Set by the caller: the map in view was measured only from behind the camera (no source
+  // keyframe ahead of it: a forward camera's last keyframes of a drive). Its scores are biased
+  // low (the surfaces ahead were seen from farther away, if at all), so flagOutliers judges it
+  // by the ZNCC floor alone and leaves it out of what is typical.
+  bool one_sided = false;
 
   [[nodiscard]] bool hasNcc() const { return ncc == ncc; }
   [[nodiscard]] bool hasDepth() const { return depth_agreement == depth_agreement; }

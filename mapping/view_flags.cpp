@@ -98,7 +98,8 @@ struct Score {
   const char* unit;  // what its support counts
   std::vector<double> value, se;
   std::vector<int> support;
-  double k = 4.0;  // flagged this many sigmas below what is typical
+  std::vector<bool> one_sided;  // judged by the floor alone
+  double k = 4.0;               // flagged this many sigmas below what is typical
   double floor = -std::numeric_limits<double>::infinity();
 };
 
@@ -111,9 +112,13 @@ ScoreThresholds thresholdsOf(const Score& s, const std::vector<double>& t_s,
   out.below.assign(n, -std::numeric_limits<double>::infinity());
   out.z.assign(n, kNan);
   reason.assign(n, "");
-  out.median = median(finiteOf(s.value));
-  const Comparison local = compare(s.value, s.se, localMedians(s.value, t_s, c), c);
-  const Comparison drive = compare(s.value, s.se, std::vector<double>(n, out.median), c);
+  std::vector<double> judged = s.value;  // what is typical comes from two-sided views only
+  for (std::size_t i = 0; i < n; ++i) {
+    if (s.one_sided[i]) judged[i] = kNan;
+  }
+  out.median = median(finiteOf(judged));
+  const Comparison local = compare(judged, s.se, localMedians(judged, t_s, c), c);
+  const Comparison drive = compare(judged, s.se, std::vector<double>(n, out.median), c);
   out.tau = local.tau;
   out.z_spread = local.z_spread;
   const double k = s.k;
@@ -174,9 +179,11 @@ FlaggedViews flagOutliers(const std::vector<ViewScore>& views, const std::vector
   if (!std::is_sorted(t_s.begin(), t_s.end())) {
     throw InvalidInput("image consistency: view times must ascend");
   }
-  Score ncc{"ncc", "patches", {}, {}, {}, c.flag_sigmas, c.min_ncc};
-  Score depth{"depth agreement", "patches", {}, {}, {}, c.depth_flag_sigmas};
+  Score ncc{"ncc", "patches", {}, {}, {}, {}, c.flag_sigmas, c.min_ncc};
+  Score depth{"depth agreement", "patches", {}, {}, {}, {}, c.depth_flag_sigmas};
   for (const ViewScore& v : views) {
+    ncc.one_sided.push_back(v.one_sided);
+    depth.one_sided.push_back(v.one_sided);
     ncc.value.push_back(v.ncc);
     ncc.se.push_back(v.ncc_se);
     ncc.support.push_back(v.patches);

@@ -100,6 +100,7 @@ struct ImageCheck::State {
   std::vector<std::size_t> sourcesFor(std::size_t keyframe) const;
   std::vector<std::size_t> otherPasses(std::size_t keyframe,
                                        const std::vector<std::size_t>& sources) const;
+  bool noneAhead(std::size_t keyframe, const std::vector<std::size_t>& sources) const;
   mapping::ViewScore scoreAgainst(std::size_t k, const std::vector<std::size_t>& sources,
                                   const cv::Mat& stereo_depth, CheckImages& drawn,
                                   std::size_t& points_drawn);
@@ -228,6 +229,16 @@ std::vector<std::size_t> ImageCheck::State::otherPasses(
     if (j < first || j > last) out.push_back(j);
   }
   return out;
+}
+
+// True when no source camera lies ahead of keyframe k's camera (along its optical axis): the map
+// it sees was measured from behind only.
+bool ImageCheck::State::noneAhead(std::size_t k, const std::vector<std::size_t>& sources) const {
+  const Eigen::Vector3d c_k = keyframes[k].T_map_c.translation();
+  const Eigen::Vector3d fwd_k = keyframes[k].T_map_c.linear().col(2);
+  return std::none_of(sources.begin(), sources.end(), [&](std::size_t j) {
+    return (keyframes[j].T_map_c.translation() - c_k).dot(fwd_k) > 0.0;
+  });
 }
 
 ImageCheck::ImageCheck(const io::RunFiles& run, const io::Dataset& dataset,
@@ -382,9 +393,11 @@ CheckedView ImageCheck::check(std::size_t k, CheckImages* images) {
       CheckImages revisit = drawn;
       std::size_t points = 0;
       view.revisit = s.scoreAgainst(k, others, stereo_depth, revisit, points);
+      view.revisit.one_sided = s.noneAhead(k, others);
     }
   }
   view.score = s.scoreAgainst(k, sources, stereo_depth, drawn, view.points_drawn);
+  view.score.one_sided = s.noneAhead(k, sources);
   if (images != nullptr) *images = drawn;
   s.trimCache();
   view.ms =

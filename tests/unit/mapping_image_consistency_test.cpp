@@ -99,7 +99,11 @@ TEST(ImageConsistency, DepthAgreesWithinOneDisparityPixel) {
   EXPECT_NEAR(score(v).depth_agreement, 0.5, 1e-12);
   EXPECT_EQ(score(v).depth_cells, (320 / 16) * (160 / 16));
   EXPECT_GT(score(v).depth_se, 0.0);  // agreeing and disagreeing patches
-  v.stereo_depth.setTo(0.0F);         // no stereo depth: not scored
+  // Every patch disagreeing alike: the spread is 0, the binomial floor over 200 patches is not.
+  v.rendered_depth.setTo(11.0F);
+  EXPECT_DOUBLE_EQ(score(v).depth_agreement, 0.0);
+  EXPECT_NEAR(score(v).depth_se, std::sqrt(2.0 / 204.0 * (1.0 - 2.0 / 204.0) / 200.0), 1e-12);
+  v.stereo_depth.setTo(0.0F);  // no stereo depth: not scored
   EXPECT_TRUE(std::isnan(score(v).depth_agreement));
   EXPECT_EQ(score(v).depth_pixels, 0U);
 }
@@ -220,6 +224,22 @@ TEST(ImageConsistency, AViewWithLittleSupportNeedsALargerDip) {
   const FlaggedViews f = flagOutliers(views, times(100), {});
   EXPECT_TRUE(f.flagged[99]);
   EXPECT_THAT(f.reason[99], testing::HasSubstr("over 400 patches"));
+}
+
+// A drive's last keyframes see a map measured from behind only: they score low with a correct
+// map, and are judged by the floor alone (not enough evidence otherwise).
+TEST(ImageConsistency, AViewOfAMapMeasuredFromBehindOnlyIsJudgedByTheFloorAlone) {
+  std::vector<ViewScore> views = drive(100, 0.0, 0, 0);
+  views[99].ncc -= 0.3;
+  views[99].ncc_se = 0.01;
+  views[99].patches = 300;
+  EXPECT_TRUE(flagOutliers(views, times(100), {}).flagged[99]);
+  views[99].one_sided = true;
+  const FlaggedViews f = flagOutliers(views, times(100), {});
+  EXPECT_FALSE(f.flagged[99]);
+  EXPECT_EQ(f.status[99], ViewStatus::kNotEnoughEvidence);
+  views[99].ncc = 0.05;  // a map that does not correlate with its image, from any side
+  EXPECT_TRUE(flagOutliers(views, times(100), {}).flagged[99]);
 }
 
 // How well stereo depths agree depends on the world's surfaces: a drive that agrees little
