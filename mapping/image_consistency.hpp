@@ -45,9 +45,11 @@ struct ImageConsistencyConfig {
   // The flag rule (flagOutliers), the same for both scores. A view's score s is compared with the
   // median m of the views within +-local_window_s/2 (the scenery changes slowly along a drive), or
   // with the whole drive's median where fewer than min_views_to_flag views are that near. Its
-  // residual s - m is judged against its own standard error se and the spread tau that correct
-  // views show around their neighbours beyond their errors (estimated from the drive:
-  // tau^2 = (1.4826 MAD of the residuals)^2 - median se^2). A view is flagged when
+  // residual s - m is judged against the standard error se it would have if it were correct (the
+  // drive's median per-patch spread over the square root of this view's patches: its own spread
+  // grows with a fault) and the spread tau that correct views show around their neighbours beyond
+  // their errors (estimated from the drive: tau^2 = (1.4826 MAD of the residuals)^2 - median
+  // se^2). A view is flagged when
   // (s - m) / sqrt(tau^2 + se^2) < -k x the robust spread of these standardised residuals over the
   // drive (at least 1): a normal score flags Phi(-k) of correct views, 3e-5 at k = 4; the benchmark
   // measures the rate on each world (tests/bench/image_check_matrix.sh). k is flag_sigmas for the

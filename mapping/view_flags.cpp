@@ -103,6 +103,26 @@ struct Score {
   double floor = -std::numeric_limits<double>::infinity();
 };
 
+// The standard error each judged view would have if it were correct: the drive's typical
+// per-patch spread (the median of se sqrt(n) over its views) over sqrt(n) of this view's
+// support. A view's own se would grow with a fault (its patches then disagree among themselves:
+// some still match, some no longer do) and hide the fault it measures; the support still sets
+// how far a view may stray (few patches, a larger error).
+std::vector<double> nullSe(const Score& s, const std::vector<double>& judged) {
+  std::vector<double> per_patch;
+  for (std::size_t i = 0; i < judged.size(); ++i) {
+    if (std::isfinite(judged[i]) && std::isfinite(s.se[i]) && s.support[i] > 0) {
+      per_patch.push_back(s.se[i] * std::sqrt(static_cast<double>(s.support[i])));
+    }
+  }
+  const double spread = median(per_patch);
+  std::vector<double> out(judged.size(), kNan);
+  for (std::size_t i = 0; i < judged.size(); ++i) {
+    if (s.support[i] > 0) out[i] = spread / std::sqrt(static_cast<double>(s.support[i]));
+  }
+  return out;
+}
+
 // The thresholds of one score; `reason` gets, per view, why it is flagged ("" when it is not).
 ScoreThresholds thresholdsOf(const Score& s, const std::vector<double>& t_s,
                              const ImageConsistencyConfig& c, std::vector<std::string>& reason) {
@@ -117,8 +137,9 @@ ScoreThresholds thresholdsOf(const Score& s, const std::vector<double>& t_s,
     if (s.one_sided[i]) judged[i] = kNan;
   }
   out.median = median(finiteOf(judged));
-  const Comparison local = compare(judged, s.se, localMedians(judged, t_s, c), c);
-  const Comparison drive = compare(judged, s.se, std::vector<double>(n, out.median), c);
+  const std::vector<double> se = nullSe(s, judged);
+  const Comparison local = compare(judged, se, localMedians(judged, t_s, c), c);
+  const Comparison drive = compare(judged, se, std::vector<double>(n, out.median), c);
   out.tau = local.tau;
   out.z_spread = local.z_spread;
   const double k = s.k;

@@ -44,7 +44,8 @@ TEST(CliConsistencyImagesRevisits, TheOtherPassAgreesWithTheTruthAndNotWithAMove
   const double own = truth["ncc"]["median"].get<double>();
   const double other = again["ncc"]["median"].get<double>();
   EXPECT_GT(other, own - 0.1) << "the true passes disagree";
-  EXPECT_EQ(again["flagged"].get<int>(), 0) << again["flags"].dump(2);
+  // At 4 sigmas a marginal flag among 75 keyframes happens (1 measured: 0.530 against 0.534).
+  EXPECT_LE(again["flagged"].get<int>(), 2) << again["flags"].dump(2);
   // The moved pass: the other pass's map is drawn 0.5 m off in both passes' images.
   const double moved_other = moved["revisits"]["ncc"]["median"].get<double>();
   EXPECT_LT(moved_other, other - 0.1) << moved["revisits"].dump(2);
@@ -53,6 +54,8 @@ TEST(CliConsistencyImagesRevisits, TheOtherPassAgreesWithTheTruthAndNotWithAMove
       "moved 0.5 m); all sources {:.3f} / {:.3f}; revisit flags {} / {}\n",
       again["keyframes"].get<int>(), other, moved_other, own, moved["ncc"]["median"].get<double>(),
       again["flagged"].get<int>(), moved["revisits"]["flagged"].get<int>());
+  // Measured: 22 of 75 revisit keyframes flagged, where the check with every source flags 2.
+  EXPECT_GE(moved["revisits"]["flagged"].get<int>(), 10) << moved["revisits"].dump(2);
   // The check with every source sees it too: half the drive's keyframes are at the revisit.
   EXPECT_LT(moved["ncc"]["median"].get<double>(), own);
   const auto lines = readText(tmp.path() / "truth" / "consistency_images" / "keyframes.csv");

@@ -226,6 +226,22 @@ TEST(ImageConsistency, AViewWithLittleSupportNeedsALargerDip) {
   EXPECT_THAT(f.reason[99], testing::HasSubstr("over 400 patches"));
 }
 
+// A misregistered map makes the view's patches disagree among themselves (some still match, some
+// no longer do), so its own standard error grows with the fault; the rule judges it by the error
+// a correct view of its support would have.
+TEST(ImageConsistency, AFaultsOwnSpreadDoesNotHideIt) {
+  std::vector<ViewScore> views = drive(100, 0.0, 0, 0);
+  for (ViewScore& v : views) {
+    v.ncc_se = 0.01;
+    v.patches = 300;
+  }
+  views[50].ncc -= 0.15;
+  views[50].ncc_se = 0.05;
+  EXPECT_TRUE(flagOutliers(views, times(100), {}).flagged[50]);
+  views[50].patches = 12;  // ... but few patches are a larger error whatever their spread
+  EXPECT_FALSE(flagOutliers(views, times(100), {}).flagged[50]);
+}
+
 // A drive's last keyframes see a map measured from behind only: they score low with a correct
 // map, and are judged by the floor alone (not enough evidence otherwise).
 TEST(ImageConsistency, AViewOfAMapMeasuredFromBehindOnlyIsJudgedByTheFloorAlone) {
