@@ -41,7 +41,7 @@ void scoreDepth(const cv::Mat& rendered_depth, const cv::Mat& stereo_depth, doub
             continue;
           }
           ++pixels;
-          const double zs = s[x];
+          const auto zs = static_cast<double>(s[x]);
           if (std::abs(static_cast<double>(r[x]) - zs) <= depthTolerance(zs, fb, c)) ++agree;
         }
       }
