@@ -138,7 +138,8 @@ ScoreThresholds thresholdsOf(const Score& s, const std::vector<double>& t_s,
   }
   out.median = median(finiteOf(judged));
   const std::vector<double> se = nullSe(s, judged);
-  const Comparison local = compare(judged, se, localMedians(judged, t_s, c), c);
+  const std::vector<double> local_median = localMedians(judged, t_s, c);
+  const Comparison local = compare(judged, se, local_median, c);
   const Comparison drive = compare(judged, se, std::vector<double>(n, out.median), c);
   out.tau = local.tau;
   out.z_spread = local.z_spread;
@@ -152,7 +153,7 @@ ScoreThresholds thresholdsOf(const Score& s, const std::vector<double>& t_s,
     std::string why;
     if (std::isfinite(local.z[i])) {
       const double scale = local.z_spread * local.d[i];
-      out.reference[i] = v - local.z[i] * local.d[i];
+      out.reference[i] = local_median[i];
       out.z[i] = local.z[i] / local.z_spread;
       out.below[i] = out.reference[i] - k * scale;
       if (v < out.below[i]) why = rule(out.below[i], out.reference[i], scale, "local");

@@ -28,10 +28,6 @@ double seconds(std::int64_t t_ns) {
   return static_cast<double>(t_ns) * 1e-9;
 }
 
-nlohmann::json finiteOrNull(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
-
 // Worst first: flagged before unflagged, then by ZNCC (unscored last), then by depth agreement.
 std::vector<std::size_t> worstOrder(const std::vector<eval::ImageCheckRow>& rows) {
   std::vector<std::size_t> order(rows.size());
@@ -133,8 +129,8 @@ nlohmann::json writeWorstImages(viz::ImageCheck& check, const eval::ImageCheckRe
     const fs::path file = out / fmt::format("worst_{}_{:.1f}s.png", n + 1, c.t_s[order[n]]);
     io::writePng(file, viz::sideBySide(images));
     worst.push_back({{"t_from_start_s", c.t_s[order[n]]},
-                     {"ncc", finiteOrNull(row.view.score.ncc)},
-                     {"depth_agreement", finiteOrNull(row.view.score.depth_agreement)},
+                     {"ncc", eval::jsonNumber(row.view.score.ncc)},
+                     {"depth_agreement", eval::jsonNumber(row.view.score.depth_agreement)},
                      {"flagged", row.flagged},
                      {"image", file.filename().string()}});
   }

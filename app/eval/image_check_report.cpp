@@ -10,10 +10,6 @@
 namespace gvio::eval {
 namespace {
 
-nlohmann::json finiteOrNull(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
-
 // The stamp as the dataset gives it (integer nanoseconds), not through a double.
 std::string stamp(std::int64_t t_ns) {
   const std::int64_t s = t_ns / 1'000'000'000, ns = t_ns % 1'000'000'000;
@@ -82,23 +78,27 @@ nlohmann::json revisitsJson(const ImageCheckResult& c) {
     }
   }
   const auto& st = c.revisit_flags.status;
-  return {{"keyframes", c.revisit_rows.size()},
-          {"flagged", flags.size()},
-          {"not_enough_evidence",
-           std::count(st.begin(), st.end(), mapping::ViewStatus::kNotEnoughEvidence)},
-          {"ncc",
-           {{"mean", finiteOrNull(meanOf(ncc))},
-            {"median", finiteOrNull(c.revisit_flags.ncc.median)},
-            {"median_minus_all_sources",
-             ncc_difference.empty() ? nlohmann::json(nullptr)
-                                    : nlohmann::json(mapping::percentile(ncc_difference, 0.5))}}},
-          {"depth_agreement",
-           {{"mean", finiteOrNull(meanOf(depth))},
-            {"median", finiteOrNull(c.revisit_flags.depth.median)}}},
-          {"flags", flags}};
+  return {
+      {"keyframes", c.revisit_rows.size()},
+      {"flagged", flags.size()},
+      {"not_enough_evidence",
+       std::count(st.begin(), st.end(), mapping::ViewStatus::kNotEnoughEvidence)},
+      {"ncc",
+       {{"mean", jsonNumber(meanOf(ncc))},
+        {"median", jsonNumber(c.revisit_flags.ncc.median)},
+        {"median_minus_all_sources",
+         ncc_difference.empty() ? nlohmann::json(nullptr)
+                                : nlohmann::json(mapping::percentile(ncc_difference, 0.5))}}},
+      {"depth_agreement",
+       {{"mean", jsonNumber(meanOf(depth))}, {"median", jsonNumber(c.revisit_flags.depth.median)}}},
+      {"flags", flags}};
 }
 
 }  // namespace
+
+nlohmann::json jsonNumber(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
 
 std::string csvNumber(double v, int decimals) {
   return std::isfinite(v) ? fmt::format("{:.{}f}", v, decimals) : std::string("nan");
@@ -194,10 +194,10 @@ nlohmann::json imageCheckSummary(const ImageCheckResult& c, std::size_t map_keyf
                     {"depth_scored", scored(false)}};
   const auto scoreJson = [&](bool ncc) {
     const mapping::ScoreThresholds& th = ncc ? c.flags.ncc : c.flags.depth;
-    return nlohmann::json{{"mean", finiteOrNull(meanOf(scoresOf(c, ncc)))},
-                          {"median", finiteOrNull(th.median)},
-                          {"spread_beyond_error", finiteOrNull(th.tau)},
-                          {"standardised_spread", finiteOrNull(th.z_spread)}};
+    return nlohmann::json{{"mean", jsonNumber(meanOf(scoresOf(c, ncc)))},
+                          {"median", jsonNumber(th.median)},
+                          {"spread_beyond_error", jsonNumber(th.tau)},
+                          {"standardised_spread", jsonNumber(th.z_spread)}};
   };
   j["ncc"] = scoreJson(true);
   j["depth_agreement"] = scoreJson(false);
@@ -220,10 +220,10 @@ nlohmann::json imageCheckSummary(const ImageCheckResult& c, std::size_t map_keyf
   j["flagged_stretches"] = stretches;
   j["revisits"] = revisitsJson(c);
   j["self_check"] = {{"keyframes", c.self_check.keyframes},
-                     {"ncc_median", finiteOrNull(c.self_check.ncc_median)},
-                     {"depth_agreement_median", finiteOrNull(c.self_check.depth_median)},
+                     {"ncc_median", jsonNumber(c.self_check.ncc_median)},
+                     {"depth_agreement_median", jsonNumber(c.self_check.depth_median)},
                      {"depth_comparable", c.self_check.depth_valid}};
-  j["ms_per_keyframe"] = {{"mean", finiteOrNull(meanOf(ms))},
+  j["ms_per_keyframe"] = {{"mean", jsonNumber(meanOf(ms))},
                           {"median", mapping::percentile(ms, 0.5)},
                           {"p90", mapping::percentile(ms, 0.9)}};
   j["options"] = {{"exclude_s", options.exclude_s},

@@ -68,5 +68,7 @@ void flagImageCheck(ImageCheckResult& result, const mapping::ImageConsistencyCon
 
 // A score as the CSV writes it ("nan" when not finite).
 [[nodiscard]] std::string csvNumber(double v, int decimals);
+// ... and as the JSON writes it (null when not finite).
+[[nodiscard]] nlohmann::json jsonNumber(double v);
 
 }  // namespace gvio::eval
