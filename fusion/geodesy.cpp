@@ -4,6 +4,7 @@
 #include <GeographicLib/UTMUPS.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "odometry/error.hpp"
@@ -55,6 +56,18 @@ bool isValidLla(const Lla& lla) {
   return std::isfinite(lla.lat_deg) && std::isfinite(lla.lon_deg) &&
          std::isfinite(lla.h_ellipsoid_m) && std::abs(lla.lat_deg) <= 90.0 &&
          std::abs(lla.lon_deg) <= 180.0;
+}
+
+std::optional<Lla> parseLla(std::string_view text) {
+  const std::string copy(text);
+  Lla lla;
+  char tail = 0;
+  if (std::sscanf(copy.c_str(), "%lf ,%lf ,%lf %c", &lla.lat_deg, &lla.lon_deg, &lla.h_ellipsoid_m,
+                  &tail) != 3 ||
+      !isValidLla(lla)) {
+    return std::nullopt;
+  }
+  return lla;
 }
 
 Utm llaToUtm(const Lla& lla) {

@@ -1,6 +1,8 @@
 #pragma once
 // WGS84 geodesy through GeographicLib: geodetic (lat, lon, ellipsoidal h) <-> ECEF <-> local ENU.
 #include <Eigen/Core>
+#include <optional>
+#include <string_view>
 
 namespace gvio::fusion {
 
@@ -34,6 +36,10 @@ class EnuFrame {
 
 // True when lat/lon/h are finite and lat in [-90, 90], lon in [-180, 180].
 bool isValidLla(const Lla& lla);
+
+// "lat,lon,h" (degrees, degrees, ellipsoidal metres; spaces allowed around the numbers); nullopt
+// when malformed or out of range.
+std::optional<Lla> parseLla(std::string_view text);
 
 // A position in the Universal Transverse Mercator grid (WGS84), for map exports (LAS, GIS).
 struct Utm {

@@ -198,6 +198,10 @@ void GnssFusion::Impl::smooth() {
       smoothNodes(graph_fixes, config.lever_arm_b, noise, config.huber_sigmas, config.smoother,
                   config.tiltSigmaRad());
   smoothed = spreadOverVio(vio, graph_fixes, nodes, noise, &smoothed_covariance);
+  stats.smoother_outliers =
+      static_cast<int>(std::count(nodes.outlier.begin(), nodes.outlier.end(), true));
+  stats.smoother_sigma_scale_h = nodes.sigma_scale_h;
+  stats.smoother_sigma_scale_v = nodes.sigma_scale_v;
   stats.ms_smoothing = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 

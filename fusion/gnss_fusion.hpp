@@ -96,6 +96,8 @@ struct FusionStats {
   std::vector<double> ms_per_fix;  // fusion cost of each processed fix (informational)
   std::vector<FixOutcome> fixes;   // every screened fix in time order (maps, plots)
   double ms_smoothing = 0.0;       // the offline smoothing pass (graph mode), 0 when not run
+  int smoother_outliers = 0;       // fixes the smoother left out (SmootherConfig::learn_noise)
+  double smoother_sigma_scale_h = 1.0, smoother_sigma_scale_v = 1.0;  // learned, on the sigmas
 };
 
 class GnssFusion {

@@ -1,5 +1,6 @@
 #include "fusion/gnss_smoother.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <memory>
@@ -53,11 +54,31 @@ void SmootherConfig::validate() const {
     throw InvalidInput("config: fusion.smoother.bias_tau_s must be > 0");
   }
   if (max_iterations < 1) throw InvalidInput("config: fusion.smoother.max_iterations must be >= 1");
+  if (min_fixes_to_learn < 2) {
+    throw InvalidInput("config: fusion.smoother.min_fixes_to_learn must be >= 2");
+  }
+  if (!(std::isfinite(outlier_chi2) && outlier_chi2 > 0.0)) {
+    throw InvalidInput("config: fusion.smoother.outlier_chi2 must be > 0");
+  }
+  if (!(std::isfinite(min_learned_scale) && min_learned_scale > 0.0)) {
+    throw InvalidInput("config: fusion.smoother.min_learned_scale must be > 0");
+  }
+  if (max_rounds < 1) throw InvalidInput("config: fusion.smoother.max_rounds must be >= 1");
 }
 
-SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Vector3d& lever_arm_b,
-                          const RelativeNoise& noise, double huber_sigmas,
-                          const SmootherConfig& config, double tilt_sigma_rad) {
+namespace {
+
+// One batch solve over the fixes with use[k], their sigmas scaled; the whitened residual of
+// every fix (used or not) against the solution, in the scaled sigmas.
+struct SmootherSolve {
+  SmoothedNodes nodes;
+  std::vector<Eigen::Vector3d> residual;
+};
+
+SmootherSolve solveOnce(const std::vector<SmootherFix>& fixes, const std::vector<bool>& use,
+                        double scale_h, double scale_v, const Eigen::Vector3d& lever_arm_b,
+                        const RelativeNoise& noise, double huber_sigmas,
+                        const SmootherConfig& config, double tilt_sigma_rad) {
   const std::size_t n = fixes.size();
   // Every parameter block in one buffer, poses then biases: ceres::Covariance orders the blocks
   // by address, and two separate allocations came in either order from run to run (measured: the
@@ -75,21 +96,31 @@ SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Ve
   popts.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   popts.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(popts);
+  // Each fix's factor: owned by the problem when used, else by `left_out` (its residual is still
+  // evaluated against the solution).
+  std::vector<ceres::CostFunction*> fix_factors(n, nullptr);
+  std::vector<std::unique_ptr<ceres::CostFunction>> left_out;
   for (std::size_t k = 0; k < n; ++k) {
     const SmootherFix& f = fixes[k];
+    const double sigma_h = f.sigma_h_m * scale_h, sigma_v = f.sigma_v_m * scale_v;
     odometry::poseToBlock(f.T_enu_b, poses[k]);
     problem.AddParameterBlock(poses[k], odometry::kPoseAmbient, &manifold);
+    if (with_bias) problem.AddParameterBlock(biases[k], 3);
     if (tilt_sigma_rad > 0.0) {
       const Eigen::Vector3d g_b = f.T_w_b.rotation().transpose() * Eigen::Vector3d::UnitZ();
       problem.AddResidualBlock(new TiltFactor(g_b, tilt_sigma_rad), nullptr, poses[k]);
     }
     if (with_bias) {
-      problem.AddResidualBlock(
-          new GnssBiasedPositionFactor(lever_arm_b, f.p_enu, f.sigma_h_m, f.sigma_v_m), &loss,
-          poses[k], biases[k]);
+      fix_factors[k] = new GnssBiasedPositionFactor(lever_arm_b, f.p_enu, sigma_h, sigma_v);
     } else {
-      problem.AddResidualBlock(
-          new GnssPositionFactor(lever_arm_b, f.p_enu, f.sigma_h_m, f.sigma_v_m), &loss, poses[k]);
+      fix_factors[k] = new GnssPositionFactor(lever_arm_b, f.p_enu, sigma_h, sigma_v);
+    }
+    if (use[k]) {
+      std::vector<double*> blocks = {poses[k]};
+      if (with_bias) blocks.push_back(biases[k]);
+      problem.AddResidualBlock(fix_factors[k], &loss, blocks);
+    } else {
+      left_out.emplace_back(fix_factors[k]);
     }
     if (k == 0) continue;
     const Eigen::Isometry3d T_rel = fixes[k - 1].T_w_b.inverse() * f.T_w_b;
@@ -100,24 +131,90 @@ SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Ve
     if (with_bias) {
       const double dt = static_cast<double>(f.t_ns - fixes[k - 1].t_ns) * 1e-9;
       problem.AddResidualBlock(
-          new GaussMarkovFactor(dt, config.bias_tau_s, config.bias_ratio * f.sigma_h_m), nullptr,
+          new GaussMarkovFactor(dt, config.bias_tau_s, config.bias_ratio * sigma_h), nullptr,
           biases[k - 1], biases[k]);
     }
   }
   if (with_bias && n > 0) {
     // The stationary distribution of the bias at the first fix: N(0, sigma^2 I).
     const Eigen::Matrix3d A =
-        Eigen::Matrix3d::Identity() / (config.bias_ratio * fixes.front().sigma_h_m);
+        Eigen::Matrix3d::Identity() / (config.bias_ratio * fixes.front().sigma_h_m * scale_h);
     problem.AddResidualBlock(new ceres::NormalPrior(A, Eigen::Vector3d::Zero()), nullptr,
                              biases[0]);
   }
   const ceres::Solver::Options options = batchSolverOptions(config.max_iterations);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
-  SmoothedNodes out;
-  out.T_enu_b.reserve(n);
-  for (const double* p : poses) out.T_enu_b.push_back(odometry::poseFromBlock(p));
-  out.covariance = nodeCovariances(problem, poses);
+  SmootherSolve out;
+  out.nodes.T_enu_b.reserve(n);
+  for (const double* p : poses) out.nodes.T_enu_b.push_back(odometry::poseFromBlock(p));
+  out.nodes.covariance = nodeCovariances(problem, poses);
+  out.residual.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double* blocks[2] = {poses[k], biases[k]};
+    fix_factors[k]->Evaluate(blocks, out.residual[k].data(), nullptr);
+  }
+  return out;
+}
+
+double robustSpread(std::vector<double> values) {
+  if (values.empty()) return 1.0;
+  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  return 1.4826 * *mid;
+}
+
+}  // namespace
+
+SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Vector3d& lever_arm_b,
+                          const RelativeNoise& noise, double huber_sigmas,
+                          const SmootherConfig& config, double tilt_sigma_rad) {
+  const std::size_t n = fixes.size();
+  std::vector<bool> use(n, true);
+  double scale_h = 1.0, scale_v = 1.0;
+  SmootherSolve solve;
+  for (int round = 0;; ++round) {
+    solve = solveOnce(fixes, use, scale_h, scale_v, lever_arm_b, noise, huber_sigmas, config,
+                      tilt_sigma_rad);
+    const auto used = static_cast<int>(std::count(use.begin(), use.end(), true));
+    if (!config.learn_noise || round + 1 >= config.max_rounds || used < config.min_fixes_to_learn) {
+      break;
+    }
+    // The spread of the used fixes' whitened residuals, horizontal (east and north) and vertical.
+    std::vector<double> h, v;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (!use[k]) continue;
+      h.push_back(std::abs(solve.residual[k].x()));
+      h.push_back(std::abs(solve.residual[k].y()));
+      v.push_back(std::abs(solve.residual[k].z()));
+    }
+    const double spread_h = robustSpread(h), spread_v = robustSpread(v);
+    const double detect_h = std::max(spread_h, config.min_learned_scale);
+    const double detect_v = std::max(spread_v, config.min_learned_scale);
+    bool changed = false;
+    for (std::size_t k = 0; k < n; ++k) {
+      const Eigen::Vector3d& r = solve.residual[k];
+      const double d2 = (r.x() * r.x() + r.y() * r.y()) / (detect_h * detect_h) +
+                        r.z() * r.z() / (detect_v * detect_v);
+      const bool inlier = d2 <= config.outlier_chi2;
+      if (inlier != use[k]) changed = true;
+      use[k] = inlier;
+    }
+    if (std::count(use.begin(), use.end(), true) < 2) {  // nothing left to smooth with: keep all
+      std::fill(use.begin(), use.end(), true);
+      break;
+    }
+    const double next_h = scale_h * std::max(1.0, spread_h);
+    const double next_v = scale_v * std::max(1.0, spread_v);
+    if (!changed && next_h == scale_h && next_v == scale_v) break;
+    scale_h = next_h;
+    scale_v = next_v;
+  }
+  SmoothedNodes out = std::move(solve.nodes);
+  out.outlier.resize(n);
+  for (std::size_t k = 0; k < n; ++k) out.outlier[k] = !use[k];
+  out.sigma_scale_h = scale_h;
+  out.sigma_scale_v = scale_v;
   return out;
 }
 

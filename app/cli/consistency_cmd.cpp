@@ -9,8 +9,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include <sstream>
-
 #include "cli/app.hpp"
 #include "cli/consistency_images.hpp"
 #include "fleet/merged_consistency.hpp"
@@ -42,16 +40,12 @@ struct ConsistencyOptions {
 // Points of a merged map compared at most (thinned evenly per tile).
 constexpr std::size_t kMergedMapPoints = 10'000'000;
 
-// "lat,lon,h" (degrees, degrees, ellipsoidal metres).
 fusion::Lla parseOrigin(const std::string& text) {
-  fusion::Lla lla;
-  char c1 = 0, c2 = 0;
-  std::istringstream in(text);
-  if (!(in >> lla.lat_deg >> c1 >> lla.lon_deg >> c2 >> lla.h_ellipsoid_m) || c1 != ',' ||
-      c2 != ',' || !in.eof() || !fusion::isValidLla(lla)) {
+  const auto lla = fusion::parseLla(text);
+  if (!lla) {
     throw InvalidInput("--reference-origin '" + text + "': expected lat,lon,h (degrees, metres)");
   }
-  return lla;
+  return *lla;
 }
 
 // A `gvio merge` folder: the tiles' points against the mesh, overall and per drive.

@@ -10,11 +10,14 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/app.hpp"
+#include "eval/eval_inputs.hpp"
 #include "eval/evaluate.hpp"
 #include "eval/plots.hpp"
+#include "eval/position_errors.hpp"
 #include "eval/revisits.hpp"
 #include "eval/revisits_plot.hpp"
 #include "io/atomic_write.hpp"
+#include "io/geo_track.hpp"
 #include "io/intervals.hpp"
 #include "io/text.hpp"
 #include "io/trajectory_io.hpp"
@@ -25,35 +28,14 @@ namespace {
 
 struct EvalCliOptions {
   std::string ref, est, ref_format = "auto", est_format = "auto";
-  std::optional<std::string> ref_times, est_times, json, plot, est_aligned, outages;
+  std::optional<std::string> ref_times, est_times, json, plot, est_aligned, outages, origin,
+      errors_csv;
   // Taken as text and parsed here, so a bad value is a one-line InvalidInput like other input.
   std::optional<std::string> revisits_radius, revisits_min_separation;
   std::string align = "none", relation = "trans", rpe_unit = "frames", plot_plane = "auto";
   std::optional<double> rpe_delta;
   double t_max_diff_s = 0.01, t_offset_s = 0.0;
 };
-
-Trajectory load(const std::string& file, const std::string& format,
-                const std::optional<std::string>& times) {
-  const io::TrajectoryFormat f =
-      format == "auto" ? io::detectTrajectoryFormat(file) : *io::parseTrajectoryFormat(format);
-  std::optional<std::filesystem::path> times_path;
-  if (times) times_path = *times;
-  // Stamps as evo takes them: real benchmark files repeat one now and then (TUM RGB-D fr2/desk's
-  // ground truth does), and evo associates them regardless (each pose of the shorter trajectory
-  // to the nearest stamp of the other, the first of equals). Said once, with a count.
-  Trajectory traj = io::readTrajectory(file, f, times_path, io::StampOrder::kAsGiven);
-  const io::StampOrderSummary order = io::summarizeStampOrder(traj.t_ns);
-  if (order.repeated + order.steps_back > 0) {
-    spdlog::warn(
-        "{}: {} repeated timestamps and {} steps back (the first at pose {}, t = {} s): "
-        "associated as evo does, each pose of the shorter trajectory with the nearest stamp of "
-        "the other (the first of equal stamps)",
-        file, order.repeated, order.steps_back, order.first_index + 1,
-        io::formatSeconds(traj.t_ns[order.first_index]));
-  }
-  return traj;
-}
 
 std::string alignmentName(eval::Alignment a) {
   switch (a) {
@@ -122,6 +104,47 @@ nlohmann::json revisitsJson(const eval::RevisitResult& v) {
   return j;
 }
 
+nlohmann::json axisJson(const eval::AxisStats& a) {
+  nlohmann::json j = statsJson(a.stats);
+  j["p95"] = a.p95;
+  return j;
+}
+
+// Horizontal and vertical errors in the ENU frame, overall and per quality flag of the estimate's
+// epochs: the table, and the same in `json` ("enu_origin", "horizontal", "vertical",
+// "by_quality").
+std::string positionReport(const eval::EvalResult& r, const eval::EvalInputs& in,
+                           nlohmann::json& json) {
+  const fusion::Lla& origin = *in.enu_origin;
+  json["enu_origin"] = {{"lat_deg", origin.lat_deg},
+                        {"lon_deg", origin.lon_deg},
+                        {"h_ellipsoid_m", origin.h_ellipsoid_m}};
+  const eval::PositionErrors all = eval::positionErrors(r);
+  json["horizontal"] = axisJson(all.horizontal);
+  json["vertical"] = axisJson(all.vertical);
+  std::string out = fmt::format("in local ENU at {:.8f}, {:.8f}, {:.3f} m\n", origin.lat_deg,
+                                origin.lon_deg, origin.h_ellipsoid_m);
+  out += statsTable("horizontal error (m)", all.horizontal.stats, all.horizontal.p95);
+  out += "\n" + statsTable("vertical error |dz| (m)", all.vertical.stats, all.vertical.p95);
+  const std::vector<int> quality = in.est.geo ? in.est.geo->quality : std::vector<int>{};
+  json["by_quality"] = nlohmann::json::array();
+  const auto groups = eval::positionErrorsByQuality(r, quality);
+  if (!groups.empty()) {
+    out += fmt::format("\n{:<16} {:>7} {:>10} {:>10} {:>10} {:>10}\n", "estimate quality", "n",
+                       "h median", "h rmse", "h p95", "v rmse");
+  }
+  for (const auto& [q, e] : groups) {
+    out += fmt::format("{:<16} {:>7} {:>10.4f} {:>10.4f} {:>10.4f} {:>10.4f}\n", io::qualityName(q),
+                       e.horizontal.stats.n, e.horizontal.stats.median, e.horizontal.stats.rmse,
+                       e.horizontal.p95, e.vertical.stats.rmse);
+    json["by_quality"].push_back({{"quality", q},
+                                  {"name", io::qualityName(q)},
+                                  {"horizontal", axisJson(e.horizontal)},
+                                  {"vertical", axisJson(e.vertical)}});
+  }
+  return out;
+}
+
 nlohmann::json resultJson(const eval::EvalResult& r,
                           const std::optional<eval::RevisitResult>& revisits,
                           const EvalCliOptions& o) {
@@ -142,6 +165,23 @@ nlohmann::json resultJson(const eval::EvalResult& r,
                 {"associated", r.ref.size()},
                 {"paired_by_index", r.paired_by_index}};
   return j;
+}
+
+// One line per associated pose: its time, APE and the position error est - ref per axis (in the
+// reference's frame: east, north, up where a side is a GNSS track), and the estimate epoch's
+// quality flag where it states one (NMEA GGA convention).
+void writeErrorsCsv(const std::string& file, const eval::EvalResult& r,
+                    const std::vector<int>& est_quality) {
+  std::string csv = "t_s,ape,dx_m,dy_m,dz_m,quality\n";
+  for (std::size_t i = 0; i < r.ref.size(); ++i) {
+    const Eigen::Vector3d d = r.est[i].topRightCorner<3, 1>() - r.ref[i].topRightCorner<3, 1>();
+    const std::string quality =
+        est_quality.empty() ? "" : std::to_string(est_quality.at(r.est_index[i]));
+    csv += fmt::format("{},{:.6f},{:.6f},{:.6f},{:.6f},{}\n",
+                       r.t_ns.empty() ? std::to_string(i) : io::formatSeconds(r.t_ns[i]), r.ape[i],
+                       d.x(), d.y(), d.z(), quality);
+  }
+  io::writeTextAtomic(file, csv);
 }
 
 void writeAligned(const std::string& file, const eval::EvalResult& r) {
@@ -265,9 +305,13 @@ int runEval(const EvalCliOptions& o) {
     throw gvio::InvalidInput("--plot-plane: expected auto, xy, xz or yz");
   }
   const std::optional<eval::RevisitOptions> revisit_options = revisitOptions(o);
-  const Trajectory ref = load(o.ref, o.ref_format, o.ref_times);
-  const Trajectory est = load(o.est, o.est_format, o.est_times);
-  const eval::EvalResult r = eval::evaluate(ref, est, opt);
+  const eval::EvalInputs in = eval::loadEvalInputs({o.ref, o.ref_format, o.ref_times},
+                                                   {o.est, o.est_format, o.est_times}, o.origin);
+  if (in.enu_origin && opt.relation != eval::Relation::kTranslation) {
+    throw gvio::InvalidInput("--relation " + o.relation +
+                             ": a GNSS track has positions only; use --relation trans");
+  }
+  const eval::EvalResult r = eval::evaluate(in.ref.trajectory, in.est.trajectory, opt);
   std::optional<eval::RevisitResult> revisits;
   if (revisit_options) revisits = eval::computeRevisits(r.ref, r.est, r.t_ns, *revisit_options);
 
@@ -283,9 +327,14 @@ int runEval(const EvalCliOptions& o) {
                                 r.rpe->stats);
   }
   if (revisits) report += "\n" + revisitsTable(*revisits);
+  nlohmann::json json = resultJson(r, revisits, o);
+  if (in.enu_origin) report += "\n" + positionReport(r, in, json);
   std::cout << report;
-  if (o.json) io::writeTextAtomic(*o.json, resultJson(r, revisits, o).dump(2) + "\n");
+  if (o.json) io::writeTextAtomic(*o.json, json.dump(2) + "\n");
   if (o.est_aligned) writeAligned(*o.est_aligned, r);
+  if (o.errors_csv) {
+    writeErrorsCsv(*o.errors_csv, r, in.est.geo ? in.est.geo->quality : std::vector<int>{});
+  }
   if (o.plot) {
     for (const auto& file : plot(r, o)) spdlog::info("wrote {}", file);
     if (revisits) {
@@ -301,13 +350,22 @@ Command addEvalCommand(CLI::App& app) {
   auto o = std::make_shared<EvalCliOptions>();
   CLI::App* sub = app.add_subcommand(
       "eval", "APE / RPE of an estimate against a reference, as evo computes them");
-  const auto formats = CLI::IsMember({"auto", "tum", "kitti", "euroc"});
-  sub->add_option("--ref", o->ref, "Reference trajectory file")->required();
-  sub->add_option("--est", o->est, "Estimated trajectory file")->required();
-  sub->add_option("--ref-format", o->ref_format, "auto guesses from the first line")
+  const auto formats = CLI::IsMember({"auto", "tum", "kitti", "euroc", "gnss"});
+  sub->add_option("--ref", o->ref,
+                  "Reference: a trajectory (TUM, KITTI, EuRoC) or a GNSS track (RTKLIB .pos, "
+                  "NMEA, GNSS CSV, a GNSS/INS reference CSV)")
+      ->required();
+  sub->add_option("--est", o->est, "Estimate: the same kinds of file")->required();
+  sub->add_option("--ref-format", o->ref_format,
+                  "auto guesses from the first line; gnss: a GNSS track")
       ->check(formats);
-  sub->add_option("--est-format", o->est_format, "auto guesses from the first line")
+  sub->add_option("--est-format", o->est_format,
+                  "auto guesses from the first line; gnss: a GNSS track")
       ->check(formats);
+  sub->add_option("--origin", o->origin,
+                  "lat,lon,h: the ENU origin of the local trajectory compared with a GNSS track "
+                  "(a run's georef.json enu_origin); with two GNSS tracks, the frame's origin "
+                  "(default: the reference's first position)");
   sub->add_option("--ref-times", o->ref_times,
                   "Times file for a KITTI reference (seconds per line)");
   sub->add_option("--est-times", o->est_times, "Times file for a KITTI estimate");
@@ -324,6 +382,9 @@ Command addEvalCommand(CLI::App& app) {
   sub->add_option("--json", o->json,
                   "Write {\"ape\": {...}, \"rpe\": {...}} statistics to this file");
   sub->add_option("--est-aligned", o->est_aligned, "Write the aligned, associated estimate (TUM)");
+  sub->add_option("--errors-csv", o->errors_csv,
+                  "Write each associated pose's time, APE and position error est - ref (x, y, z; "
+                  "east, north, up with a GNSS track) as CSV");
   sub->add_option("--plot", o->plot,
                   "Write PREFIX_{trajectory,error,axes}.{png,svg} (and PREFIX_revisits.{png,svg} "
                   "with --revisits)");

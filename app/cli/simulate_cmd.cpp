@@ -16,7 +16,7 @@ struct SimulateCliOptions {
   sim::SimRequest request;
   std::string format = "kitti-raw", camera = "stereo", gnss = "spp";
   std::vector<std::string> outages;
-  std::optional<std::string> times, world_style;
+  std::optional<std::string> times, world_style, gnss_errors_from;
   std::string orientation = "file";
   std::string trajectory, out;
   ConfigOptions config;
@@ -60,6 +60,7 @@ int runSimulate(SimulateCliOptions& o, const CommonOptions& common) {
   r.output = *io::parseDatasetFormat(o.format);
   r.stereo = o.camera == "stereo";
   r.gnss = sim::parseGnssNoise(o.gnss);
+  if (o.gnss_errors_from) r.gnss_errors_from = *o.gnss_errors_from;
   for (const auto& text : o.outages) r.outages_s.push_back(parseOutage(text));
   std::optional<Progress> progress;  // created once the frame count is known
   const sim::SimSummary s =
@@ -101,11 +102,13 @@ Command addSimulateCommand(CLI::App& app, const CommonOptions& common) {
   CLI::App* sub =
       app.add_subcommand("simulate", "Simulate a stereo/mono + IMU + GNSS drive with exact truth");
   sub->add_option("--trajectory", o->trajectory,
-                  "Poses to drive: TUM (body, z up) or KITTI odometry (cam0)")
+                  "Poses to drive: TUM (body, z up), KITTI odometry (cam0) or a GNSS/INS "
+                  "reference CSV (GPS TOW, week, lat, lon, height, roll, pitch, heading: driven "
+                  "where it was recorded)")
       ->required();
   sub->add_option("--trajectory-format", o->request.trajectory_format,
                   "auto guesses from the first line")
-      ->check(CLI::IsMember({"auto", "tum", "kitti"}));
+      ->check(CLI::IsMember({"auto", "tum", "kitti", "reference"}));
   sub->add_option("--times", o->times, "Times file of a KITTI trajectory (seconds per line)");
   sub->add_option("--orientation", o->orientation,
                   "file (default): the file's body orientation, warned about when its x axis is "
@@ -120,6 +123,11 @@ Command addSimulateCommand(CLI::App& app, const CommonOptions& common) {
       ->check(CLI::IsMember({"stereo", "mono"}));
   sub->add_option("--gnss-noise", o->gnss, "GNSS error model")
       ->check(CLI::IsMember({"none", "spp", "rtk"}));
+  sub->add_option("--gnss-errors-from", o->gnss_errors_from,
+                  "A real receiver's solution (RTKLIB .pos, NMEA, GNSS CSV) of the reference "
+                  "--trajectory's drive: each epoch it solved becomes a fix with its real error "
+                  "(fix - reference), sigmas and quality; its gaps stay gaps")
+      ->excludes(sub->get_option("--gnss-noise"));
   sub->add_option("--gnss-outage", o->outages,
                   "T0:T1 seconds since the start without fixes (repeatable)")
       ->take_all()

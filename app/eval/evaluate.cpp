@@ -35,6 +35,7 @@ void associate(const Trajectory& ref, const Trajectory& est, const EvalOptions& 
   for (std::size_t k = 0; k < a.ref.size(); ++k) {
     r.ref.push_back(ref.poses[a.ref[k]].matrix());
     r.est.push_back(est.poses[a.est[k]].matrix());
+    r.est_index.push_back(a.est[k]);
     if (ref.hasTimestamps()) r.t_ns.push_back(ref.t_ns[a.ref[k]]);
   }
 }

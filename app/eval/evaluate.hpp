@@ -28,6 +28,7 @@ struct EvalResult {
   Sim3 alignment;                         // applied to the estimate (identity for none)
   std::vector<std::int64_t> t_ns;         // stamps of the associated poses (ref's; empty if none)
   std::vector<Eigen::Matrix4d> ref, est;  // associated poses, estimate aligned
+  std::vector<std::size_t> est_index;     // each associated pose's index in the estimate
   std::vector<double> ape;
   Stats ape_stats;
   std::optional<RpeResult> rpe;

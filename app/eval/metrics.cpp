@@ -5,9 +5,11 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <numeric>
 #include <utility>
 
+#include "io/text.hpp"
 #include "odometry/error.hpp"
 
 namespace gvio::eval {
@@ -86,33 +88,73 @@ std::pair<std::size_t, std::int64_t> nearestSorted(const std::vector<std::int64_
   return {best, best_diff};
 }
 
-// The same by a full scan, for stamps in any order (evo reads files unsorted and checks nothing).
-std::pair<std::size_t, std::int64_t> nearestScan(const std::vector<std::int64_t>& b,
-                                                 std::int64_t target) {
-  std::size_t best = 0;
-  std::int64_t best_diff = std::numeric_limits<std::int64_t>::max();
-  for (std::size_t j = 0; j < b.size(); ++j) {
-    const std::int64_t diff = b[j] > target ? b[j] - target : target - b[j];
-    if (diff < best_diff) {
-      best = j;
-      best_diff = diff;
-    }
+// A stamp as evo holds it: the double nearest to its decimal seconds (what numpy parses from the
+// file's text), not the double nearest to the nanoseconds / 1e9.
+double evoSeconds(std::int64_t t_ns) {
+  return std::strtod(io::formatSeconds(t_ns).c_str(), nullptr);
+}
+
+// The first index of runs of equal stamps next to b[best] (below and above), for re-ranking.
+std::vector<std::size_t> neighbours(const std::vector<std::int64_t>& b, std::size_t best) {
+  std::vector<std::size_t> out{best};
+  if (best > 0) {
+    const auto below = std::lower_bound(b.begin(), b.end(), b[best - 1]);
+    out.push_back(static_cast<std::size_t>(below - b.begin()));
   }
-  return {best, best_diff};
+  const auto above = std::upper_bound(b.begin(), b.end(), b[best]);
+  if (above != b.end()) out.push_back(static_cast<std::size_t>(above - b.begin()));
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 // evo sync.matching_time_indices: for each stamp of `a`, the index of the nearest stamp of
-// `b + offset` (numpy argmin: the first of equals), kept when |dt| <= max_diff.
+// `b + offset` (numpy argmin: the first of equals), kept when |dt| <= max_diff. evo computes
+// |(b + offset) - a| in float64 seconds, so where two stamps of b lie equally far from a's in
+// exact nanoseconds (a 10 Hz estimate halfway between 5 Hz reference stamps), rounding decides:
+// the exact search finds the nearest stamps, and those within a microsecond of the nearest are
+// ranked, and the tolerance applied, by evo's float64 arithmetic.
 void matchNearest(const std::vector<std::int64_t>& a, const std::vector<std::int64_t>& b,
                   std::int64_t max_diff_ns, std::int64_t offset_b_ns, std::vector<std::size_t>& ia,
                   std::vector<std::size_t>& ib) {
+  constexpr std::int64_t kRerankNs = 1000;
   const bool sorted = std::is_sorted(b.begin(), b.end());
+  const double offset_s = offset_b_ns >= 0 ? evoSeconds(offset_b_ns) : -evoSeconds(-offset_b_ns);
+  const double max_diff_s = static_cast<double>(max_diff_ns) / 1e9;
+  if (!sorted) {  // evo's scan, literally: every stamp of b in float64
+    std::vector<double> b_s(b.size());
+    for (std::size_t j = 0; j < b.size(); ++j) b_s[j] = evoSeconds(b[j]) + offset_s;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const double a_s = evoSeconds(a[i]);
+      std::size_t best = 0;
+      for (std::size_t j = 1; j < b.size(); ++j) {
+        if (std::abs(b_s[j] - a_s) < std::abs(b_s[best] - a_s)) best = j;
+      }
+      if (!b.empty() && std::abs(b_s[best] - a_s) <= max_diff_s) {
+        ia.push_back(i);
+        ib.push_back(best);
+      }
+    }
+    return;
+  }
   for (std::size_t i = 0; i < a.size(); ++i) {
     const std::int64_t target = a[i] - offset_b_ns;  // b[j] + offset ~ a[i]
-    const auto [best, best_diff] = sorted ? nearestSorted(b, target) : nearestScan(b, target);
-    if (best_diff <= max_diff_ns) {
+    const auto [best, best_diff] = nearestSorted(b, target);
+    if (best_diff > max_diff_ns + kRerankNs) continue;
+    const double a_s = evoSeconds(a[i]);
+    std::size_t chosen = best;
+    double chosen_diff = std::numeric_limits<double>::infinity();
+    for (const std::size_t j : neighbours(b, best)) {
+      const std::int64_t exact = b[j] > target ? b[j] - target : target - b[j];
+      if (exact > best_diff + kRerankNs) continue;
+      const double diff = std::abs((evoSeconds(b[j]) + offset_s) - a_s);
+      if (diff < chosen_diff) {
+        chosen = j;
+        chosen_diff = diff;
+      }
+    }
+    if (chosen_diff <= max_diff_s) {
       ia.push_back(i);
-      ib.push_back(best);
+      ib.push_back(chosen);
     }
   }
 }

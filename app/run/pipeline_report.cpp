@@ -71,10 +71,16 @@ void logSummary(const RunState& s, const Evaluations& e) {
         fused_ape += fmt::format(" final, {:.3f} m online", e.fused_online->ape->rmse);
       }
     }
-    spdlog::info("GNSS {}: {} fixes used, {} rejected, {} skipped, {} outage(s){}",
-                 fusion::toString(s.gnss->mode), s.gnss->stats.fixes_used,
-                 s.gnss->stats.fixes_rejected, s.gnss->screening.skipped(),
-                 s.gnss->stats.outages.size(), fused_ape);
+    const fusion::FusionStats& g = s.gnss->stats;
+    std::string smoother;
+    if (s.gnss->smoothed) {
+      smoother =
+          fmt::format(", smoother: {} left out, sigmas x {:.2f} h / {:.2f} v", g.smoother_outliers,
+                      g.smoother_sigma_scale_h, g.smoother_sigma_scale_v);
+    }
+    spdlog::info("GNSS {}: {} fixes used, {} rejected, {} skipped, {} outage(s){}{}",
+                 fusion::toString(s.gnss->mode), g.fixes_used, g.fixes_rejected,
+                 s.gnss->screening.skipped(), g.outages.size(), smoother, fused_ape);
   }
   const TimingSummary total = summarizeTimings(s.vio.timings.total_ms);
   spdlog::info(

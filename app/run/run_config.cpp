@@ -1,7 +1,6 @@
 #include "run/run_config.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 #include "odometry/error.hpp"
@@ -28,11 +27,8 @@ void ImuConfig::validate() const {
 
 std::optional<fusion::Lla> FusionAppConfig::originLla() const {
   if (origin == "first-fix") return std::nullopt;
-  fusion::Lla lla;
-  char tail = 0;
-  if (std::sscanf(origin.c_str(), "%lf,%lf,%lf%c", &lla.lat_deg, &lla.lon_deg, &lla.h_ellipsoid_m,
-                  &tail) != 3 ||
-      !fusion::isValidLla(lla)) {
+  const auto lla = fusion::parseLla(origin);
+  if (!lla) {
     throw InvalidInput("config: fusion.origin must be first-fix or lat,lon,h (got '" + origin +
                        "')");
   }

@@ -7,15 +7,18 @@
 #include <optional>
 
 #include "io/atomic_write.hpp"
+#include "io/gnss_file.hpp"
 #include "io/image_loader.hpp"
 #include "io/input_error.hpp"
 #include "io/kitti_calib.hpp"
 #include "io/mesh_ply.hpp"
+#include "io/reference_csv.hpp"
 #include "io/text.hpp"
 #include "io/trajectory_io.hpp"
 #include "sim/bag_output.hpp"
 #include "sim/camera_sim.hpp"
 #include "sim/dataset_writers.hpp"
+#include "sim/gnss_replay.hpp"
 #include "sim/imu_synth.hpp"
 #include "sim/kitti_convention.hpp"
 #include "sim/world.hpp"
@@ -74,26 +77,77 @@ Trajectory applyOrientationSource(const Trajectory& T_w_b, const SimRequest& r,
   }
 }
 
-Trajectory loadBodyPoses(const SimRequest& r, const SimConfig& c) {
-  const io::TrajectoryFormat f = r.trajectory_format == "auto"
-                                     ? io::detectTrajectoryFormat(r.trajectory)
-                                     : *io::parseTrajectoryFormat(r.trajectory_format);
-  if (f == io::TrajectoryFormat::kKitti && !r.times) {
-    throw InvalidInput("--trajectory " + r.trajectory.string() +
-                       " is KITTI: give its --times file");
+// The poses to drive, and the reference CSV they came from (georeferenced) if they did.
+struct Drive {
+  Trajectory poses;
+  std::optional<io::ReferenceCsv> reference;
+};
+
+Drive loadDrive(const SimRequest& r, const SimConfig& c) {
+  const bool reference = r.trajectory_format == "reference" ||
+                         (r.trajectory_format == "auto" && io::looksLikeReferenceCsv(r.trajectory));
+  Drive drive;
+  io::TrajectoryFormat f = io::TrajectoryFormat::kTum;
+  if (reference) {
+    drive.reference = io::readReferenceCsv(r.trajectory);
+    const fusion::EnuFrame enu(drive.reference->epochs.front().lla);
+    if (r.orientation == OrientationSource::kFile && !drive.reference->has_attitude) {
+      throw io::InputError(r.trajectory, 1,
+                           "no roll, pitch and heading columns: use --orientation motion");
+    }
+    drive.poses = r.orientation == OrientationSource::kFile
+                      ? io::referenceBodyPoses(*drive.reference, enu)
+                      : io::referencePositions(*drive.reference, enu);
+  } else {
+    f = r.trajectory_format == "auto" ? io::detectTrajectoryFormat(r.trajectory)
+                                      : *io::parseTrajectoryFormat(r.trajectory_format);
+    if (f == io::TrajectoryFormat::kKitti && !r.times) {
+      throw InvalidInput("--trajectory " + r.trajectory.string() +
+                         " is KITTI: give its --times file");
+    }
+    drive.poses = io::readTrajectory(r.trajectory, f,
+                                     f == io::TrajectoryFormat::kKitti ? r.times : std::nullopt);
   }
-  Trajectory poses = io::readTrajectory(r.trajectory, f,
-                                        f == io::TrajectoryFormat::kKitti ? r.times : std::nullopt);
+  Trajectory& poses = drive.poses;
   if (poses.size() < 4)
     throw io::InputError(r.trajectory, 0,
                          fmt::format("{} poses; at least 4 are needed", poses.size()));
-  if (f == io::TrajectoryFormat::kKitti) poses = kittiCameraToEnuBody(poses, c.heading_deg);
+  if (!reference && f == io::TrajectoryFormat::kKitti) {
+    poses = kittiCameraToEnuBody(poses, c.heading_deg);
+  }
   poses = applyOrientationSource(poses, r, c);
   if (poses.t_ns.front() < kAbsoluteAfterNs) {
     const std::int64_t shift = kDefaultStartNs - poses.t_ns.front();
     for (auto& t : poses.t_ns) t += shift;
   }
-  return poses;
+  return drive;
+}
+
+// The fixes of the drive: the request's error model, or a real receiver's errors replayed.
+std::vector<GnssSimFix> driveGnss(const SimRequest& r, const Drive& drive,
+                                  const ContinuousTrajectory& traj, std::int64_t t1,
+                                  const fusion::EnuFrame& enu, const GnssSimOptions& options,
+                                  SimSummary& summary) {
+  const auto T_w_b_at = [&](std::int64_t t) { return traj.at(t).pose(); };
+  if (!r.gnss_errors_from) {
+    return synthesizeGnss(T_w_b_at, traj.t0_ns(), t1, enu, options, mixSeed(r.seed, 2));
+  }
+  const io::GnssFileData solution = io::readGnssFile(*r.gnss_errors_from, io::ReaderConfig{});
+  for (const std::string& w : solution.warnings) spdlog::warn("{}", w);
+  std::vector<std::int64_t> ref_t;
+  std::vector<Eigen::Vector3d> ref_p;
+  for (const io::ReferenceEpoch& e : drive.reference->epochs) {
+    ref_t.push_back(e.t_ns);
+    ref_p.push_back(enu.toEnu(e.lla));
+  }
+  const RealGnssErrors errors = realGnssErrors(solution.fixes, ref_t, ref_p, enu);
+  summary.gnss_outside_reference = errors.outside_reference + errors.in_reference_gap;
+  if (summary.gnss_outside_reference > 0) {
+    spdlog::warn(
+        "{}: {} of {} epochs lie outside the reference's span or in its gaps: not replayed",
+        r.gnss_errors_from->string(), summary.gnss_outside_reference, solution.fixes.size());
+  }
+  return replayGnss(T_w_b_at, traj.t0_ns(), t1, enu, options, errors);
 }
 
 std::vector<Eigen::Vector3d> routeOf(const ContinuousTrajectory& traj, std::int64_t t1_ns,
@@ -145,7 +199,11 @@ void writeSimYaml(const fs::path& file, const SimRequest& r, const SimSummary& s
   y << YAML::Key << "orientation" << YAML::Value << toString(r.orientation);
   y << YAML::Key << "format" << YAML::Value << io::toString(r.output);
   y << YAML::Key << "camera" << YAML::Value << (r.stereo ? "stereo" : "mono");
-  y << YAML::Key << "gnss_noise" << YAML::Value << toString(r.gnss);
+  y << YAML::Key << "gnss_noise" << YAML::Value
+    << (r.gnss_errors_from ? std::string("replayed") : toString(r.gnss));
+  if (r.gnss_errors_from) {
+    y << YAML::Key << "gnss_errors_from" << YAML::Value << r.gnss_errors_from->filename().string();
+  }
   y << YAML::Key << "gnss_outages_s" << YAML::Value << YAML::Flow << YAML::BeginSeq;
   for (const auto& [a, b] : r.outages_s)
     y << YAML::Flow << YAML::BeginSeq << a << b << YAML::EndSeq;
@@ -166,7 +224,14 @@ void writeSimYaml(const fs::path& file, const SimRequest& r, const SimSummary& s
   y << YAML::Key << "turn_on_gyr_bias_radps" << YAML::Value << YAML::Flow << YAML::BeginSeq
     << b.gyr_radps.x() << b.gyr_radps.y() << b.gyr_radps.z() << YAML::EndSeq;
   y << YAML::EndMap;
-  y << YAML::Key << "config" << YAML::Value << YAML::Load(r.config_yaml);
+  // The origin actually driven in (a reference CSV's own), so sim.yaml locates the drive.
+  YAML::Node config = YAML::Load(r.config_yaml);
+  if (config["sim"]) {
+    config["sim"]["origin_lat_deg"] = s.origin.lat_deg;
+    config["sim"]["origin_lon_deg"] = s.origin.lon_deg;
+    config["sim"]["origin_h_m"] = s.origin.h_ellipsoid_m;
+  }
+  y << YAML::Key << "config" << YAML::Value << config;
   y << YAML::Key << "result" << YAML::Value << YAML::BeginMap;
   y << YAML::Key << "duration_s" << YAML::Value << s.duration_s;
   y << YAML::Key << "path_length_m" << YAML::Value << s.path_length_m;
@@ -192,9 +257,13 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
     throw InvalidInput("--format: the simulator writes kitti-raw, euroc or rosbag");
   }
   if (r.seconds && !(*r.seconds > 0.0)) throw InvalidInput("--seconds must be positive");
-  const Trajectory poses = loadBodyPoses(r, config);
+  const Drive drive = loadDrive(r, config);
+  if (r.gnss_errors_from && !drive.reference) {
+    throw InvalidInput("--gnss-errors-from needs a georeferenced --trajectory (a reference CSV: " +
+                       r.trajectory.string() + " is not one)");
+  }
   const ContinuousTrajectory traj =
-      ContinuousTrajectory::fit(poses, {config.knot_spacing_s, config.smoothing});
+      ContinuousTrajectory::fit(drive.poses, {config.knot_spacing_s, config.smoothing});
   std::int64_t t1 = traj.t1_ns();
   if (r.seconds) t1 = std::min<std::int64_t>(t1, traj.t0_ns() + std::llround(*r.seconds * 1e9));
   const auto outages = outagesNs(r, traj.t0_ns(), t1);
@@ -220,14 +289,18 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
   imu_opt.initial_gyr_bias = summary.imu_turn_on_bias.gyr_radps;
   std::vector<ImuSimSample> imu = synthesizeImu(traj, imu_opt, mixSeed(r.seed, 1));
   std::erase_if(imu, [&](const ImuSimSample& s) { return s.measured.t_ns > t1; });
-  const fusion::EnuFrame enu({config.origin_lat_deg, config.origin_lon_deg, config.origin_h_m});
+  // A georeferenced trajectory is driven where it was recorded: its first epoch is the origin.
+  const fusion::EnuFrame enu(
+      drive.reference
+          ? drive.reference->epochs.front().lla
+          : fusion::Lla{config.origin_lat_deg, config.origin_lon_deg, config.origin_h_m});
+  summary.origin = enu.origin();
   GnssSimOptions gnss_opt;
   gnss_opt.noise = r.gnss;
   gnss_opt.rate_hz = config.gnss_rate_hz;
   gnss_opt.lever_arm_b = config.gnss_lever_arm_m;
   gnss_opt.outages_ns = outages;
-  const auto gnss_sim = synthesizeGnss([&](std::int64_t t) { return traj.at(t).pose(); },
-                                       traj.t0_ns(), t1, enu, gnss_opt, mixSeed(r.seed, 2));
+  const auto gnss_sim = driveGnss(r, drive, traj, t1, enu, gnss_opt, summary);
   std::vector<GnssFix> fixes;
   for (const auto& g : gnss_sim) fixes.push_back(g.fix);
   summary.imu_samples = imu.size();

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "fusion/geodesy.hpp"
 #include "io/dataset.hpp"
 #include "sim/body_orientation.hpp"
 #include "sim/gnss_synth.hpp"
@@ -19,7 +20,9 @@ namespace gvio::sim {
 
 struct SimRequest {
   std::filesystem::path trajectory;
-  std::string trajectory_format = "auto";  // auto|tum|kitti (KITTI = odometry cam0 poses)
+  // auto|tum|kitti|reference (KITTI = odometry cam0 poses; reference: a GNSS/INS reference CSV,
+  // io/reference_csv.hpp, georeferenced: the simulator's ENU origin becomes its first epoch)
+  std::string trajectory_format = "auto";
   std::optional<std::filesystem::path> times;
   // Where the body's orientation comes from: the file's (checked against the direction of travel,
   // with a warning) or derived from the path (heading and pitch from the direction of travel).
@@ -28,6 +31,10 @@ struct SimRequest {
   std::optional<double> seconds;                            // simulate only the first S seconds
   bool stereo = true;
   GnssNoise gnss = GnssNoise::kSpp;
+  // A real receiver's solution (RTKLIB .pos, NMEA, GNSS CSV) whose errors against the reference
+  // trajectory are replayed instead of the `gnss` model (sim/gnss_replay.hpp); needs a reference
+  // CSV as the trajectory.
+  std::optional<std::filesystem::path> gnss_errors_from;
   std::vector<std::pair<double, double>> outages_s;  // seconds since the drive's start
   std::uint64_t seed = 1;
   // The street world's seed (buildings, furniture, textures); nullopt: derived from `seed`. Two
@@ -40,6 +47,9 @@ struct SimRequest {
 
 struct SimSummary {
   std::size_t frames = 0, imu_samples = 0, gnss_fixes = 0, world_triangles = 0;
+  // --gnss-errors-from: the solution's epochs not replayed (outside the reference or in its gaps).
+  std::size_t gnss_outside_reference = 0;
+  fusion::Lla origin;  // the ENU origin driven in (sim.origin_*, or a reference CSV's first epoch)
   double duration_s = 0.0, path_length_m = 0.0;
   FitReport fit;
   ImuNoiseDraw imu_noise;       // the drive's IMU noise (sim.imu_noise_scale_*)

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "eval/evaluate.hpp"
+#include "io/text.hpp"
 #include "odometry/error.hpp"
 
 namespace gvio::eval {
@@ -102,19 +103,24 @@ TEST(EvalAssociate, JitterOffsetAndMissingStamps) {
   EXPECT_LT(r.ape_stats.max, 1e-12);  // every pose found its true partner
 }
 
-TEST(EvalAssociate, NearestWithinMaxDiffAndTies) {
+TEST(EvalAssociate, NearestWithinMaxDiff) {
   const std::vector<std::int64_t> ref = {0, 100, 200, 300};
-  const std::vector<std::int64_t> est = {49, 151, 250, 1000};  // 250 is a tie between 200 and 300
+  const std::vector<std::int64_t> est = {49, 151, 1000};
   const auto a = associateByTime(ref, est, 60, 0);
-  // Equal lengths: evo iterates the estimate and searches the reference.
-  EXPECT_EQ(a.est, (std::vector<std::size_t>{0, 1, 2}));
-  EXPECT_EQ(a.ref, (std::vector<std::size_t>{0, 2, 2}));  // 49->0, 151->200, 250->200 (lower)
+  EXPECT_EQ(a.est, (std::vector<std::size_t>{0, 1}));
+  EXPECT_EQ(a.ref, (std::vector<std::size_t>{0, 2}));                  // 49->0, 151->200
   const auto b = associateByTime(ref, {0, 100, 200, 300, 400}, 0, 0);  // longer estimate
   EXPECT_EQ(b.ref, (std::vector<std::size_t>{0, 1, 2, 3}));
 }
 
+// A stamp as evo holds it: the double numpy parses from the decimal text.
+double evoSeconds(std::int64_t t_ns) {
+  return std::strtod(io::formatSeconds(t_ns).c_str(), nullptr);
+}
+
 // evo's association, ported literally (sync.associate_trajectories + matching_time_indices):
-// the shorter trajectory (the second on equal lengths) against the longer, numpy argmin.
+// the shorter trajectory (the second on equal lengths) against the longer, numpy argmin over
+// float64 differences of the seconds.
 Association evoAssociate(const std::vector<std::int64_t>& ref, const std::vector<std::int64_t>& est,
                          std::int64_t max_diff) {
   const bool est_longer = est.size() > ref.size();
@@ -122,11 +128,12 @@ Association evoAssociate(const std::vector<std::int64_t>& ref, const std::vector
   const auto& longer = est_longer ? est : ref;
   std::vector<std::size_t> is, il;
   for (std::size_t i = 0; i < shorter.size(); ++i) {
+    const double a = evoSeconds(shorter[i]);
     std::size_t best = 0;
     for (std::size_t j = 1; j < longer.size(); ++j) {
-      if (std::llabs(longer[j] - shorter[i]) < std::llabs(longer[best] - shorter[i])) best = j;
+      if (std::abs(evoSeconds(longer[j]) - a) < std::abs(evoSeconds(longer[best]) - a)) best = j;
     }
-    if (std::llabs(longer[best] - shorter[i]) <= max_diff) {
+    if (std::abs(evoSeconds(longer[best]) - a) <= static_cast<double>(max_diff) / 1e9) {
       is.push_back(i);
       il.push_back(best);
     }
@@ -135,6 +142,23 @@ Association evoAssociate(const std::vector<std::int64_t>& ref, const std::vector
   a.ref = est_longer ? is : il;
   a.est = est_longer ? il : is;
   return a;
+}
+
+// A 10 Hz estimate halfway between a 5 Hz reference's stamps (GPS time in seconds): exact
+// nanoseconds tie, and evo's float64 seconds decide, not always for the earlier stamp.
+TEST(EvalAssociate, TiesAreDecidedAsEvoDoesInFloat64) {
+  std::vector<std::int64_t> ref, est;
+  const std::int64_t t0 = 1'689'055'532'000'000'000;
+  for (int i = 0; i < 200; ++i) ref.push_back(t0 + i * 200'000'000LL);
+  for (int i = 0; i < 199; ++i) est.push_back(t0 + 100'000'000LL + i * 200'000'000LL);
+  const Association a = associateByTime(ref, est, 100'000'000, 0);
+  const Association b = evoAssociate(ref, est, 100'000'000);
+  EXPECT_EQ(a.ref, b.ref);
+  EXPECT_EQ(a.est, b.est);
+  int later = 0;
+  for (std::size_t k = 0; k < a.est.size(); ++k) later += a.ref[k] == a.est[k] + 1 ? 1 : 0;
+  EXPECT_GT(later, 0);                               // exact arithmetic: none
+  EXPECT_LT(later, static_cast<int>(a.est.size()));  // nor always the later one
 }
 
 TEST(EvalAssociate, RepeatedAndUnsortedStampsAsEvoDoes) {
