@@ -13,13 +13,12 @@
 #include "eval/eval_inputs.hpp"
 #include "eval/evaluate.hpp"
 #include "eval/plots.hpp"
-#include "eval/position_errors.hpp"
+#include "eval/position_report.hpp"
 #include "eval/revisits.hpp"
 #include "eval/revisits_plot.hpp"
+#include "eval/stats_text.hpp"
 #include "io/atomic_write.hpp"
-#include "io/geo_track.hpp"
 #include "io/intervals.hpp"
-#include "io/text.hpp"
 #include "io/trajectory_io.hpp"
 #include "odometry/error.hpp"
 
@@ -51,23 +50,6 @@ std::string alignmentName(eval::Alignment a) {
   return "";
 }
 
-nlohmann::json statsJson(const eval::Stats& s) {
-  return {{"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median}, {"std", s.std},
-          {"min", s.min},   {"max", s.max},   {"sse", s.sse},       {"n", s.n}};
-}
-
-// evo's rows in evo's (alphabetical) order; p95 where given; the count as `count_label`.
-std::string statsTable(const std::string& title, const eval::Stats& s,
-                       std::optional<double> p95 = std::nullopt, const char* count_label = "n") {
-  std::string out = title + "\n";
-  std::vector<std::pair<const char*, double>> rows = {
-      {"max", s.max},   {"mean", s.mean}, {"median", s.median}, {"min", s.min},
-      {"rmse", s.rmse}, {"sse", s.sse},   {"std", s.std}};
-  if (p95) rows.insert(rows.begin() + 4, {"p95", *p95});
-  for (const auto& [name, value] : rows) out += fmt::format("{:>10}  {:.6f}\n", name, value);
-  return out + fmt::format("{:>10}  {}\n", count_label, s.n);
-}
-
 // Divided, not multiplied by 1e-9, so that whole seconds print whole (30, not 30.000000000000004).
 double separationS(std::int64_t t_ns) {
   return static_cast<double>(t_ns) / 1e9;
@@ -81,10 +63,11 @@ std::string revisitsScope(const eval::RevisitOptions& o) {
 
 std::string revisitsTable(const eval::RevisitResult& v) {
   if (!v.stats) return fmt::format("revisits: no pair of {}\n", revisitsScope(v.options));
-  return statsTable(fmt::format("revisit consistency |(p_est_j - p_est_i) - (p_ref_j - p_ref_i)| "
-                                "(m) over pairs of {}",
-                                revisitsScope(v.options)),
-                    v.stats->stats, v.stats->p95, "pairs");
+  return eval::statsTable(
+      fmt::format("revisit consistency |(p_est_j - p_est_i) - (p_ref_j - p_ref_i)| "
+                  "(m) over pairs of {}",
+                  revisitsScope(v.options)),
+      v.stats->stats, v.stats->p95, "pairs");
 }
 
 // The statistics are null when no pair qualifies, so the keys are always there.
@@ -93,7 +76,7 @@ nlohmann::json revisitsJson(const eval::RevisitResult& v) {
                       {"min_separation_s", separationS(v.options.min_separation_ns)},
                       {"pairs", v.pairs.size()}};
   if (v.stats) {
-    j.update(statsJson(v.stats->stats));
+    j.update(eval::statsJson(v.stats->stats));
     j["p95"] = v.stats->p95;
   } else {
     for (const char* key : {"rmse", "mean", "median", "std", "min", "max", "sse", "p95"}) {
@@ -104,53 +87,12 @@ nlohmann::json revisitsJson(const eval::RevisitResult& v) {
   return j;
 }
 
-nlohmann::json axisJson(const eval::AxisStats& a) {
-  nlohmann::json j = statsJson(a.stats);
-  j["p95"] = a.p95;
-  return j;
-}
-
-// Horizontal and vertical errors in the ENU frame, overall and per quality flag of the estimate's
-// epochs: the table, and the same in `json` ("enu_origin", "horizontal", "vertical",
-// "by_quality").
-std::string positionReport(const eval::EvalResult& r, const eval::EvalInputs& in,
-                           nlohmann::json& json) {
-  const fusion::Lla& origin = *in.enu_origin;
-  json["enu_origin"] = {{"lat_deg", origin.lat_deg},
-                        {"lon_deg", origin.lon_deg},
-                        {"h_ellipsoid_m", origin.h_ellipsoid_m}};
-  const eval::PositionErrors all = eval::positionErrors(r);
-  json["horizontal"] = axisJson(all.horizontal);
-  json["vertical"] = axisJson(all.vertical);
-  std::string out = fmt::format("in local ENU at {:.8f}, {:.8f}, {:.3f} m\n", origin.lat_deg,
-                                origin.lon_deg, origin.h_ellipsoid_m);
-  out += statsTable("horizontal error (m)", all.horizontal.stats, all.horizontal.p95);
-  out += "\n" + statsTable("vertical error |dz| (m)", all.vertical.stats, all.vertical.p95);
-  const std::vector<int> quality = in.est.geo ? in.est.geo->quality : std::vector<int>{};
-  json["by_quality"] = nlohmann::json::array();
-  const auto groups = eval::positionErrorsByQuality(r, quality);
-  if (!groups.empty()) {
-    out += fmt::format("\n{:<16} {:>7} {:>10} {:>10} {:>10} {:>10}\n", "estimate quality", "n",
-                       "h median", "h rmse", "h p95", "v rmse");
-  }
-  for (const auto& [q, e] : groups) {
-    out += fmt::format("{:<16} {:>7} {:>10.4f} {:>10.4f} {:>10.4f} {:>10.4f}\n", io::qualityName(q),
-                       e.horizontal.stats.n, e.horizontal.stats.median, e.horizontal.stats.rmse,
-                       e.horizontal.p95, e.vertical.stats.rmse);
-    json["by_quality"].push_back({{"quality", q},
-                                  {"name", io::qualityName(q)},
-                                  {"horizontal", axisJson(e.horizontal)},
-                                  {"vertical", axisJson(e.vertical)}});
-  }
-  return out;
-}
-
 nlohmann::json resultJson(const eval::EvalResult& r,
                           const std::optional<eval::RevisitResult>& revisits,
                           const EvalCliOptions& o) {
   nlohmann::json j;
-  j["ape"] = statsJson(r.ape_stats);
-  if (r.rpe) j["rpe"] = statsJson(r.rpe->stats);
+  j["ape"] = eval::statsJson(r.ape_stats);
+  if (r.rpe) j["rpe"] = eval::statsJson(r.rpe->stats);
   if (revisits) j["revisits"] = revisitsJson(*revisits);
   const auto& a = r.alignment;
   j["alignment"] = {{"mode", o.align},
@@ -165,23 +107,6 @@ nlohmann::json resultJson(const eval::EvalResult& r,
                 {"associated", r.ref.size()},
                 {"paired_by_index", r.paired_by_index}};
   return j;
-}
-
-// One line per associated pose: its time, APE and the position error est - ref per axis (in the
-// reference's frame: east, north, up where a side is a GNSS track), and the estimate epoch's
-// quality flag where it states one (NMEA GGA convention).
-void writeErrorsCsv(const std::string& file, const eval::EvalResult& r,
-                    const std::vector<int>& est_quality) {
-  std::string csv = "t_s,ape,dx_m,dy_m,dz_m,quality\n";
-  for (std::size_t i = 0; i < r.ref.size(); ++i) {
-    const Eigen::Vector3d d = r.est[i].topRightCorner<3, 1>() - r.ref[i].topRightCorner<3, 1>();
-    const std::string quality =
-        est_quality.empty() ? "" : std::to_string(est_quality.at(r.est_index[i]));
-    csv += fmt::format("{},{:.6f},{:.6f},{:.6f},{:.6f},{}\n",
-                       r.t_ns.empty() ? std::to_string(i) : io::formatSeconds(r.t_ns[i]), r.ape[i],
-                       d.x(), d.y(), d.z(), quality);
-  }
-  io::writeTextAtomic(file, csv);
 }
 
 void writeAligned(const std::string& file, const eval::EvalResult& r) {
@@ -320,20 +245,21 @@ int runEval(const EvalCliOptions& o) {
                                    r.paired_by_index ? "paired by index" : "associated by time",
                                    alignmentName(opt.align));
   if (opt.align == eval::Alignment::kSim3) report += fmt::format(" (scale {:.6f})", r.alignment.s);
-  report += "\n\n" + statsTable("APE w.r.t. " + eval::describe(opt.relation), r.ape_stats);
+  report += "\n\n" + eval::statsTable("APE w.r.t. " + eval::describe(opt.relation), r.ape_stats);
   if (r.rpe) {
-    report += "\n" + statsTable(fmt::format("RPE w.r.t. {} for delta = {} ({}), consecutive pairs",
+    report +=
+        "\n" + eval::statsTable(fmt::format("RPE w.r.t. {} for delta = {} ({}), consecutive pairs",
                                             eval::describe(opt.relation), *o.rpe_delta, o.rpe_unit),
                                 r.rpe->stats);
   }
   if (revisits) report += "\n" + revisitsTable(*revisits);
   nlohmann::json json = resultJson(r, revisits, o);
-  if (in.enu_origin) report += "\n" + positionReport(r, in, json);
+  if (in.enu_origin) report += "\n" + eval::positionReport(r, in, json);
   std::cout << report;
   if (o.json) io::writeTextAtomic(*o.json, json.dump(2) + "\n");
   if (o.est_aligned) writeAligned(*o.est_aligned, r);
   if (o.errors_csv) {
-    writeErrorsCsv(*o.errors_csv, r, in.est.geo ? in.est.geo->quality : std::vector<int>{});
+    eval::writeErrorsCsv(*o.errors_csv, r, in.est.geo ? in.est.geo->quality : std::vector<int>{});
   }
   if (o.plot) {
     for (const auto& file : plot(r, o)) spdlog::info("wrote {}", file);
