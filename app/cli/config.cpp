@@ -275,6 +275,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("dataset.nmea_uere_rtk_float_m", c.dataset.nmea_uere_rtk_float_m),
       number("dataset.nmea_uere_rtk_fixed_m", c.dataset.nmea_uere_rtk_fixed_m),
       number("dataset.nmea_vertical_factor", c.dataset.nmea_vertical_factor),
+      text("dataset.nmea_checksum", c.dataset.nmea_checksum),
       number("dataset.comma2k19_sigma_h_m", c.dataset.comma2k19_sigma_h_m),
       number("dataset.comma2k19_sigma_v_m", c.dataset.comma2k19_sigma_v_m),
       text("dataset.topics.cam0", c.dataset.topic_cam0),

@@ -47,6 +47,10 @@ struct Collected {
   std::multimap<std::int64_t, GstSigma> gst;  // by time of day
   Skipped bad_checksum;
   Skipped no_fix;
+  // Per sentence type ("RMC", "GGA", "P" for vendor sentences, ...): all seen, and those whose
+  // checksum failed.
+  std::map<std::string, std::size_t, std::less<>> seen, failed;
+  std::size_t vendor = 0;  // proprietary ($P...) sentences
 };
 
 bool allDigits(std::string_view s) {
@@ -197,16 +201,34 @@ std::optional<std::string_view> verifiedBody(std::string_view sentence) {
   return body;
 }
 
-void parseSentence(std::string_view sentence, const LineReader& at, NmeaLog& log, Collected& out) {
+// The sentence type of an address: "GGA" of "GPGGA" (2-letter talker + 3-letter type), "P" for a
+// proprietary (vendor) sentence, "" for anything else.
+std::string_view sentenceType(std::string_view address) {
+  if (address.starts_with('P')) return "P";
+  return address.size() == 5 ? address.substr(2) : std::string_view();
+}
+
+// The body of a sentence as written, without its checksum, when that is wrong or missing.
+std::string_view bodyAsWritten(std::string_view sentence) {
+  const auto star = sentence.find('*');
+  return sentence.substr(1, star == std::string_view::npos ? std::string_view::npos : star - 1);
+}
+
+void parseSentence(std::string_view sentence, const LineReader& at, NmeaLog& log, Collected& out,
+                   const ReaderConfig& config) {
   ++log.sentences;
-  const auto body = verifiedBody(sentence);
+  auto body = verifiedBody(sentence);
+  const std::string_view written = body ? *body : bodyAsWritten(sentence);
+  const std::string_view type = sentenceType(written.substr(0, written.find(',')));
+  ++out.seen[std::string(type)];
   if (!body) {
     out.bad_checksum.add(at.lineNumber());
-    return;
+    ++out.failed[std::string(type)];
+    if (config.nmea_checksum != "warn") return;
+    body = written;  // read as written
   }
   const auto fields = splitDelimited(*body, ',');
-  // Address = 2-letter talker + 3-letter type; proprietary ($P...) and odd addresses are "other".
-  const std::string_view type = fields[0].size() == 5 ? fields[0].substr(2) : std::string_view();
+  if (type == "P") ++out.vendor;
   if (type == "GGA") return parseGga(fields, at, out);
   if (type == "RMC") return parseRmc(fields, at, out);
   if (type == "GST") return parseGst(fields, at, out);
@@ -309,6 +331,39 @@ void warnSkipped(NmeaLog& log, const std::filesystem::path& file, const Skipped&
                          std::to_string(skipped.first_line) + ")");
 }
 
+// "1748 of 1748 RMC, 2 of 1750 GGA sentences failed their checksum (first at line 2)".
+std::string failedSummary(const Collected& in) {
+  std::string parts;
+  for (const auto& [type, count] : in.failed) {
+    if (!parts.empty()) parts += ", ";
+    const std::string name = type == "P" ? "vendor ($P...)" : type.empty() ? "unknown" : type;
+    parts += std::to_string(count) + " of " + std::to_string(in.seen.at(type)) + " " + name;
+  }
+  return parts + " sentences failed their checksum (first at line " +
+         std::to_string(in.bad_checksum.first_line) + ")";
+}
+
+// refuse: a few failed sentences are line noise; more, or most of one type, is a logger that
+// writes wrong checksums (or a file that is not what it seems), and reading on would either drop
+// every sentence of that type or trust them unchecked: the user decides (warn or skip).
+void checkChecksums(const std::filesystem::path& file, const NmeaLog& log, const Collected& in,
+                    const ReaderConfig& config) {
+  if (config.nmea_checksum != "refuse" || in.bad_checksum.count == 0) return;
+  bool systematic = 100 * in.bad_checksum.count > log.sentences;
+  for (const auto& [type, count] : in.failed)
+    systematic = systematic || 2 * count > in.seen.at(type);
+  if (!systematic) return;
+  std::size_t gga = 0;
+  if (const auto it = in.seen.find("GGA"); it != in.seen.end()) gga = it->second;
+  throw InputError(
+      file, 0,
+      failedSummary(in) + "; of " + std::to_string(log.sentences) + " sentences, " +
+          std::to_string(gga) + " GGA (" + std::to_string(in.no_fix.count) +
+          " without a position), " + std::to_string(in.vendor) +
+          " vendor: set dataset.nmea_checksum: warn to read them as written, or skip to leave "
+          "them out");
+}
+
 }  // namespace
 
 std::uint8_t nmeaChecksum(std::string_view body) {
@@ -336,13 +391,20 @@ NmeaLog readNmea(const std::filesystem::path& file, const ReaderConfig& config) 
     if (line.front() != '$') {
       reader.fail("not an NMEA sentence (expected a line starting with '$')");
     }
-    parseSentence(line, reader, log, collected);
+    parseSentence(line, reader, log, collected, config);
   }
+  checkChecksums(file, log, collected, config);
   log.fixes = datedFixes(file, collected, config);
   log.bad_checksum = collected.bad_checksum.count;
   log.no_fix = collected.no_fix.count;
-  warnSkipped(log, file, collected.bad_checksum, "sentence", "sentences",
-              "with a bad or missing checksum");
+  log.vendor_sentences = collected.vendor;
+  if (config.nmea_checksum == "warn" && collected.bad_checksum.count > 0) {
+    log.warnings.push_back(file.string() + ": " + failedSummary(collected) +
+                           ", read as written (dataset.nmea_checksum: warn)");
+  } else {
+    warnSkipped(log, file, collected.bad_checksum, "sentence", "sentences",
+                "with a bad or missing checksum");
+  }
   warnSkipped(log, file, collected.no_fix, "GGA sentence", "GGA sentences", "without a fix");
   return log;
 }

@@ -19,13 +19,15 @@ struct NmeaLog {
   std::size_t bad_checksum = 0;       // skipped: checksum missing or wrong
   std::size_t no_fix = 0;             // GGA with quality 0 (or an empty position) skipped
   std::size_t other_sentences = 0;    // valid sentences of other types (GSV, VTG, ...) ignored
+  std::size_t vendor_sentences = 0;   // of which proprietary ($P...)
   std::vector<std::string> warnings;  // one line per kind of skip: count and first line number
 };
 
-// Reads every line of `file`. Skips (and counts) sentences with a bad checksum and GGA without a
-// fix; throws InputError naming file and line on malformed GGA/RMC/GST fields, non-NMEA lines,
-// timestamps that do not increase, or GGA fixes without any RMC to date them. A log without any
-// GGA fix is valid and gives no fixes.
+// Reads every line of `file`. Sentences with a bad or missing checksum as config.nmea_checksum
+// says (refused with the counts per type when more than line noise, read, or skipped); skips and
+// counts GGA without a fix; throws InputError naming file and line on malformed GGA/RMC/GST fields,
+// non-NMEA lines, timestamps that do not increase, or GGA fixes without any RMC to date them. A log
+// without any GGA fix is valid and gives no fixes.
 NmeaLog readNmea(const std::filesystem::path& file, const ReaderConfig& config);
 
 // XOR of the characters of `body`, the part of a sentence between '$' and '*'.

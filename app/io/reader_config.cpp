@@ -30,6 +30,10 @@ void ReaderConfig::validate() const {
   requirePositive(nmea_uere_rtk_float_m, "dataset.nmea_uere_rtk_float_m");
   requirePositive(nmea_uere_rtk_fixed_m, "dataset.nmea_uere_rtk_fixed_m");
   requirePositive(nmea_vertical_factor, "dataset.nmea_vertical_factor");
+  if (nmea_checksum != "refuse" && nmea_checksum != "warn" && nmea_checksum != "skip") {
+    throw InvalidInput("config: dataset.nmea_checksum must be refuse, warn or skip (got '" +
+                       nmea_checksum + "')");
+  }
   requirePositive(comma2k19_sigma_h_m, "dataset.comma2k19_sigma_h_m");
   requirePositive(comma2k19_sigma_v_m, "dataset.comma2k19_sigma_v_m");
   if (!std::isfinite(stereo_sync_tolerance_s) || stereo_sync_tolerance_s < 0.0) {

@@ -17,6 +17,11 @@ struct ReaderConfig {
   double nmea_uere_rtk_fixed_m = 0.02;
   // Vertical sigma = horizontal sigma x this (VDOP is typically 1.5-2 x HDOP).
   double nmea_vertical_factor = 2.0;
+  // Sentences whose checksum is wrong or missing. refuse: a few (at most 1 % of the sentences and
+  // at most half of any one type: line noise) are left out with a warning, more refuse the log
+  // with the counts per type (a logger that writes every RMC with a wrong checksum); warn: read
+  // as they are, with a warning and the counts; skip: always left out, with a warning.
+  std::string nmea_checksum = "refuse";  // refuse | warn | skip
   // comma2k19's u-blox CSV has no accuracy columns: 1-sigma horizontal (per axis) and vertical.
   double comma2k19_sigma_h_m = 1.0;
   double comma2k19_sigma_v_m = 2.0;

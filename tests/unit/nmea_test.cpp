@@ -1,5 +1,6 @@
 #include "io/nmea.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -160,6 +161,7 @@ TEST_F(NmeaTest, FollowingRmcOnlyDatesEarlierFixes) {
 }
 
 TEST_F(NmeaTest, BadChecksumIsSkippedAndReported) {
+  config_.nmea_checksum = "skip";
   std::string corrupted = gga("120001");
   corrupted[20] = corrupted[20] == '7' ? '8' : '7';  // a digit of the latitude
   const NmeaLog log = read({rmc("120000", "010124"), gga("120000"), corrupted, gga("120002")});
@@ -173,6 +175,7 @@ TEST_F(NmeaTest, BadChecksumIsSkippedAndReported) {
 }
 
 TEST_F(NmeaTest, MissingOrTruncatedChecksumIsSkipped) {
+  config_.nmea_checksum = "skip";
   std::string no_checksum = gga("120001");
   no_checksum.resize(no_checksum.size() - 3);
   std::string truncated = gga("120002");
@@ -184,6 +187,52 @@ TEST_F(NmeaTest, MissingOrTruncatedChecksumIsSkipped) {
   ASSERT_EQ(log.warnings.size(), 1u);
   EXPECT_NE(log.warnings[0].find("3 sentences"), std::string::npos) << log.warnings[0];
   EXPECT_NE(log.warnings[0].find("line 3"), std::string::npos) << log.warnings[0];
+}
+
+// A real reference logger writes every RMC with a wrong checksum: by default the log is refused
+// with the counts per type (not read as a log without dates); `warn` reads the sentences as
+// written; one corrupted sentence among many (line noise) is left out with a warning.
+TEST_F(NmeaTest, ChecksumsThatFailSystematicallyRefuseTheLogUnlessTold) {
+  std::vector<std::string> lines;
+  for (int s = 0; s < 60; ++s) {
+    const std::string t = fmt::format("1200{:02}", s);
+    std::string bad_rmc = rmc(t, "010124");
+    bad_rmc.back() = bad_rmc.back() == '0' ? '1' : '0';
+    lines.push_back(bad_rmc);
+    lines.push_back(gga(t));
+  }
+  lines.push_back(withNmeaChecksum("PUBX,00,120100,,,,,"));
+  const std::string error = errorOf(lines);
+  EXPECT_NE(error.find("60 of 60 RMC sentences failed their checksum (first at line 1)"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("60 GGA (0 without a position), 1 vendor"), std::string::npos) << error;
+  EXPECT_NE(error.find("dataset.nmea_checksum: warn"), std::string::npos) << error;
+
+  config_.nmea_checksum = "warn";
+  const NmeaLog warned = read(lines);
+  EXPECT_EQ(warned.fixes.size(), 60u);
+  EXPECT_EQ(warned.bad_checksum, 60u);
+  EXPECT_EQ(warned.vendor_sentences, 1u);
+  ASSERT_EQ(warned.warnings.size(), 1u);
+  EXPECT_NE(warned.warnings[0].find("60 of 60 RMC sentences failed their checksum"),
+            std::string::npos)
+      << warned.warnings[0];
+
+  // Line noise: one GGA of 240 sentences.
+  config_.nmea_checksum = "refuse";
+  std::vector<std::string> noisy;
+  for (int s = 0; s < 60; ++s) {
+    const std::string t = fmt::format("1200{:02}", s);
+    noisy.push_back(rmc(t, "010124"));
+    noisy.push_back(gga(t));
+    noisy.push_back(withNmeaChecksum("GPVTG,,T,,M,0.0,N,0.0,K,A"));
+    noisy.push_back(withNmeaChecksum("GPGSV,1,1,00"));
+  }
+  noisy[5].back() = noisy[5].back() == '0' ? '1' : '0';  // the second GGA
+  const NmeaLog log = read(noisy);
+  EXPECT_EQ(log.fixes.size(), 59u);
+  EXPECT_EQ(log.bad_checksum, 1u);
 }
 
 TEST_F(NmeaTest, LowercaseChecksumIsAccepted) {
