@@ -22,7 +22,21 @@ struct Layout {
   std::string time_system;  // GPST | UTC | JST
   bool ecef = false;        // else lat/lon in degrees
   bool geodetic_height = false;
+  // The data column of the first velocity (vn or vx, m/s) when RTKLIB wrote velocities
+  // ("Output Velocity"), else none.
+  std::optional<std::size_t> velocity_column;
 };
+
+// The header names one column for the time, which is two fields in the data (date and time, or
+// week and seconds): a column named after it is one field further right.
+std::optional<std::size_t> velocityColumn(std::string_view header, bool ecef) {
+  const std::vector<std::string_view> names = splitWhitespace(header.substr(1));
+  const std::string_view first = ecef ? "vx(m/s)" : "vn(m/s)";
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (names[i] == first) return i + 1;
+  }
+  return std::nullopt;
+}
 
 bool contains(std::string_view s, std::string_view what) {
   return s.find(what) != std::string_view::npos;
@@ -139,6 +153,7 @@ PosFile readRtklibPos(const std::filesystem::path& file, const ReaderConfig& con
             "heights are above the geoid (RTKLIB 'Height: Geodetic'): write ellipsoidal "
             "heights");
       }
+      layout->velocity_column = velocityColumn(last_header, layout->ecef);
       out.time_system = layout->time_system;
       out.position_format = layout->ecef ? "ecef" : "llh";
     }
@@ -188,6 +203,19 @@ PosFile readRtklibPos(const std::filesystem::path& file, const ReaderConfig& con
     }
     if (!fusion::isValidLla({fix.lat_deg, fix.lon_deg, fix.h_ellipsoid_m})) {
       in.fail("position out of range");
+    }
+    if (const auto c = layout->velocity_column; c && f.size() >= *c + 3) {
+      const Eigen::Vector3d v(parseFinite(f[*c], in, "velocity"),
+                              parseFinite(f[*c + 1], in, "velocity"),
+                              parseFinite(f[*c + 2], in, "velocity"));
+      // vn ve vu, or ECEF vx vy vz: over ground as speed and course (clockwise from north).
+      const Eigen::Vector3d v_enu =
+          layout->ecef
+              ? Eigen::Vector3d(fusion::EnuFrame({fix.lat_deg, fix.lon_deg, 0.0}).R_enu_ecef() * v)
+              : Eigen::Vector3d(v.y(), v.x(), v.z());
+      fix.speed_mps = std::hypot(v_enu.x(), v_enu.y());
+      fix.course_deg = std::fmod(std::atan2(v_enu.x(), v_enu.y()) * 180.0 / M_PI + 360.0, 360.0);
+      ++out.with_velocity;
     }
     const double floor_h = fix.quality == 4   ? config.nmea_uere_rtk_fixed_m
                            : fix.quality == 5 ? config.nmea_uere_rtk_float_m

@@ -6,7 +6,9 @@
 //  - position: latitude/longitude in degrees + ellipsoidal height with sdn, sde, sdu (and the
 //    signed square roots of the covariances sdne, sdeu, sdun), or ECEF x, y, z with sdx..sdzx
 //    (converted to lat/lon/h, the covariance rotated into east-north-up);
-//  - Q: 1 fix, 2 float, 3 SBAS, 4 DGPS, 5 single, 6 PPP; 0 (no solution) is skipped and counted.
+//  - Q: 1 fix, 2 float, 3 SBAS, 4 DGPS, 5 single, 6 PPP; 0 (no solution) is skipped and counted;
+//  - velocities when RTKLIB wrote them (vn ve vu, or vx vy vz in ECEF): the fix's speed and course
+//    over ground, as NMEA RMC gives them (GNSS/INS uses them).
 // Each fix's sigma is RTKLIB's own, but never below the floor of its quality (the NMEA reader's
 // dataset.nmea_uere_* values: a receiver's formal sigma is optimistic): horizontal =
 // sqrt((sdn^2 + sde^2) / 2) per axis, vertical = sdu, the vertical floor times
@@ -29,6 +31,7 @@ struct PosFile {
   std::string time_system;            // "GPST", "UTC" or "JST"
   std::string position_format;        // "llh" or "ecef"
   std::size_t no_solution = 0;        // Q 0 lines skipped
+  std::size_t with_velocity = 0;      // fixes with RTKLIB's velocity columns (speed and course)
   std::vector<std::string> warnings;  // one line per kind of skip
 };
 

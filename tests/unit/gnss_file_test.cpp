@@ -143,6 +143,31 @@ std::string posError(const std::string& text) {
   return "no error";
 }
 
+// RTKLIB's "Output Velocity": vn ve vu after age and ratio become the fix's speed and course over
+// ground (the Nagoya drive's solutions have them).
+TEST(RtklibPos, VelocitiesBecomeSpeedAndCourse) {
+  test::TempDir dir("pos_velocity");
+  const fs::path file = dir.path() / "v.pos";
+  test::writeText(
+      file,
+      "%  GPST                  latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   sde(m)"
+      "   sdu(m)  sdne(m)  sdeu(m)  sdun(m) age(s)  ratio    vn(m/s)    ve(m/s)    vu(m/s)      "
+      "sdvn     sdve     sdvu    sdvne    sdveu    sdvun\n"
+      "2023/07/11 06:04:52.000   35.165392498  136.881438532    39.1758   5  20   3.4222   3.9538"
+      "   8.3261   1.5321   1.6609  -1.1737   0.00    0.0    3.00000   -4.00000   0.10000   "
+      "0.09824  0.10787  0.25052  0.05435  0.05135  0.05065\n"
+      "2023/07/11 06:04:53.000   35.165392498  136.881438532    39.1758   5  20   3.4222   3.9538"
+      "   8.3261   1.5321   1.6609  -1.1737   0.00    0.0\n");
+  const PosFile pos = readRtklibPos(file, ReaderConfig{});
+  ASSERT_EQ(pos.fixes.size(), 2u);
+  EXPECT_EQ(pos.with_velocity, 1u);
+  EXPECT_NEAR(pos.fixes[0].speed_mps, 5.0, 1e-9);
+  EXPECT_NEAR(pos.fixes[0].course_deg, 360.0 - std::atan2(4.0, 3.0) * 180.0 / M_PI, 1e-9);
+  EXPECT_TRUE(std::isnan(pos.fixes[1].speed_mps));  // a line without them
+  // Without the columns in the header, nothing is taken for a velocity.
+  EXPECT_TRUE(std::isnan(readRtklibPos(dir.path() / "v.pos", ReaderConfig{}).fixes[1].course_deg));
+}
+
 TEST(RtklibPos, BadFilesNameTheFileAndLine) {
   const std::string line = "2011/10/03 12:55:49.000 48.98 8.39 114.9 5 11 2 1 3 0 0 0 0 0\n";
   EXPECT_THAT(posError("%  GPST  e-baseline(m) n-baseline(m) u-baseline(m) Q ns sde(m) sdn(m) "
