@@ -44,9 +44,13 @@ std::optional<nlohmann::json> readReport(const fs::path& run_dir) {
   }
 }
 
-// What gvio run writes last of all (run/run_status.hpp): the folder holds a whole run.
+// What gvio run writes last of all (run/run_status.hpp): the folder holds a whole run ("partial":
+// a finished run whose trajectory covers only part of its drive, run/coverage.hpp; running it
+// again would give the same).
 bool saysComplete(const std::optional<nlohmann::json>& report) {
-  return report && report->value("status", "") == "complete";
+  if (!report) return false;
+  const std::string status = report->value("status", "");
+  return status == "complete" || status == "partial";
 }
 
 }  // namespace

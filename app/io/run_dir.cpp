@@ -158,7 +158,8 @@ std::optional<std::string> incompleteRunWarning(const fs::path& dir) {
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
   if (!j.is_object() || !j.contains("status") || !j["status"].is_string()) return std::nullopt;
   const std::string status = j["status"].get<std::string>();
-  if (status == "complete") return std::nullopt;
+  // "partial": finished, its trajectory covering only part of the input (it said so when it ran).
+  if (status == "complete" || status == "partial") return std::nullopt;
   // Only words of gvio's own are echoed: the file may hold anything.
   const auto word = [](const std::string& w) {
     return !w.empty() && w.size() <= 32 && std::all_of(w.begin(), w.end(), [](char c) {

@@ -11,6 +11,7 @@
 #include "io/dataset_summary.hpp"
 #include "io/trajectory_io.hpp"
 #include "odometry/error.hpp"
+#include "run/coverage.hpp"
 #include "run/gnss_run.hpp"
 #include "run/report.hpp"
 #include "run/stats.hpp"
@@ -182,12 +183,22 @@ void writeGnssInsOutputs(const std::filesystem::path& out, const InsRunResult& r
   io::writeTextAtomic(out / "georef.json", j.dump(2) + "\n");
 }
 
+Coverage insCoverage(const io::Dataset& ds, const InsRunResult& r) {
+  std::vector<std::int64_t> imu;
+  imu.reserve(ds.imu.size());
+  for (const auto& sample : ds.imu) imu.push_back(sample.t_ns);
+  return coverageOf(imu, r.fused.t_ns);
+}
+
 json gnssInsReport(const io::Dataset& ds, const InsRunResult& r, const InsReportContext& ctx) {
   const fusion::InsStats& s = r.stats;
   const std::optional<Eigen::Vector2d> nhc = nhcMeanInnovation(s);
   json report;
   report["gvio_version"] = GVIO_VERSION;
-  report["status"] = "complete";  // a run in progress or cut short says so (run/run_status.hpp)
+  // A run in progress or cut short says so (run/run_status.hpp); one that started late, "partial".
+  const Coverage coverage = insCoverage(ds, r);
+  report["status"] = runStatus(coverage);
+  report["coverage"] = coverageJson(coverage);
   report["command_line"] = ctx.command_line;
   report["dataset"] = datasetJson(ds);
   report["mode"] = "gnss-ins";

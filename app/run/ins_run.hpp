@@ -14,6 +14,7 @@
 #include "fusion/gnss_screening.hpp"
 #include "io/dataset.hpp"
 #include "odometry/measurements.hpp"
+#include "run/coverage.hpp"
 
 namespace gvio::run {
 
@@ -65,6 +66,9 @@ struct InsReportContext {
   double peak_rss_mb = 0.0;
   const InsEvaluation* evaluation = nullptr;  // null: no truth in the run's frame
 };
+
+// How much of the IMU's span the GNSS/INS trajectory covers (run/coverage.hpp).
+Coverage insCoverage(const io::Dataset& dataset, const InsRunResult& run);
 
 nlohmann::json gnssInsReport(const io::Dataset& dataset, const InsRunResult& run,
                              const InsReportContext& context);

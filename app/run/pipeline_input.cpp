@@ -102,11 +102,13 @@ bool runGnssInsInstead(RunState& s) {
         evaluation->fused_h->rmse, evaluation->fused_3d->rmse, evaluation->raw_h->rmse,
         evaluation->raw_3d->rmse);
   }
+  const Coverage coverage = insCoverage(ds, r);
   spdlog::info(
       "GNSS/INS: {} fixes used, {} rejected, {} before init, {} outage(s), time offset {:.3f} +- "
-      "{:.3f} s{}; wrote {}",
+      "{:.3f} s{}{}; wrote {}",
       r.stats.fixes_used, r.stats.fixes_rejected, r.stats.fixes_before_init, r.stats.outages.size(),
-      r.final_state.time_offset_s, r.time_offset_sigma_s, figures, out.string());
+      r.final_state.time_offset_s, r.time_offset_sigma_s, figures, partialNote(coverage),
+      out.string());
   return true;
 }
 

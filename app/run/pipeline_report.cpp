@@ -74,9 +74,10 @@ void logSummary(const RunState& s, const Evaluations& e) {
     const fusion::FusionStats& g = s.gnss->stats;
     std::string smoother;
     if (s.gnss->smoothed) {
-      smoother =
-          fmt::format(", smoother: {} left out, sigmas x {:.2f} h / {:.2f} v", g.smoother_outliers,
-                      g.smoother_sigma_scale_h, g.smoother_sigma_scale_v);
+      smoother = fmt::format(", smoother: {} left out, sigmas x", g.smoother_outliers);
+      for (const auto& [quality, scale] : g.smoother_sigma_scale) {
+        smoother += fmt::format(" {:.2f} h / {:.2f} v (quality {})", scale.x(), scale.y(), quality);
+      }
     }
     spdlog::info("GNSS {}: {} fixes used, {} rejected, {} skipped, {} outage(s){}{}",
                  fusion::toString(s.gnss->mode), g.fixes_used, g.fixes_rejected,
@@ -84,9 +85,9 @@ void logSummary(const RunState& s, const Evaluations& e) {
   }
   const TimingSummary total = summarizeTimings(s.vio.timings.total_ms);
   spdlog::info(
-      "{} frames, {} keyframes, {} poses written, {}, {:.1f} ms/frame (p95 {:.1f}); wrote {}",
+      "{} frames, {} keyframes, {} poses written, {}, {:.1f} ms/frame (p95 {:.1f}){}; wrote {}",
       s.vio.counters.frames, s.vio.counters.keyframes, s.vio.trajectory.size(), ape, total.mean,
-      total.p95, s.request.out.string());
+      total.p95, partialNote(vioCoverage(s.dataset, s.vio)), s.request.out.string());
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "io/dataset_summary.hpp"
+#include "run/coverage.hpp"
 #include "run/stats.hpp"
 
 namespace gvio::run {
@@ -61,10 +62,20 @@ json datasetJson(const io::Dataset& ds) {
   return j;
 }
 
+Coverage vioCoverage(const io::Dataset& ds, const VioRunResult& run) {
+  std::vector<std::int64_t> frames;
+  frames.reserve(ds.frames.size());
+  for (const auto& f : ds.frames) frames.push_back(f.t_ns);
+  return coverageOf(frames, run.trajectory.t_ns);
+}
+
 json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportContext& ctx) {
   json report;
   report["gvio_version"] = GVIO_VERSION;
-  report["status"] = "complete";  // a run in progress or cut short says so (run/run_status.hpp)
+  // A run in progress or cut short says so (run/run_status.hpp); one that started late, "partial".
+  const Coverage coverage = vioCoverage(ds, run);
+  report["status"] = runStatus(coverage);
+  report["coverage"] = coverageJson(coverage);
   report["command_line"] = ctx.command_line;
   report["dataset"] = datasetJson(ds);
   report["mode"] = odometry::toString(run.mode);

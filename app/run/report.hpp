@@ -8,6 +8,7 @@
 
 #include "io/dataset.hpp"
 #include "odometry/measurements.hpp"
+#include "run/coverage.hpp"
 #include "run/evaluation.hpp"
 #include "run/gnss_run.hpp"
 #include "run/vio_runner.hpp"
@@ -36,6 +37,9 @@ struct ReportContext {
 // report.json's "dataset": path, format, variant, sensor counts, IMU rate, ground truth source
 // (shared by the VIO and the GNSS/INS reports).
 nlohmann::json datasetJson(const io::Dataset& dataset);
+
+// How much of the dataset's frames the VIO trajectory covers (run/coverage.hpp).
+Coverage vioCoverage(const io::Dataset& dataset, const VioRunResult& run);
 
 nlohmann::json buildReport(const io::Dataset& dataset, const VioRunResult& run,
                            const ReportContext& context);
