@@ -185,7 +185,7 @@ void GnssFusion::Impl::addNodePriors(GraphNode& node, bool first) {
 
 void GnssFusion::Impl::noteGraphNode(const Pair& pair) {
   graph_fixes.push_back({pair.t_ns, pair.T_w_b, graph.newest().T_enu_b(), pair.p_enu,
-                         pair.fix.sigma_h_m, pair.fix.sigma_v_m});
+                         pair.fix.sigma_h_m, pair.fix.sigma_v_m, pair.fix.quality});
 }
 
 void GnssFusion::Impl::smooth() {
@@ -200,8 +200,7 @@ void GnssFusion::Impl::smooth() {
   smoothed = spreadOverVio(vio, graph_fixes, nodes, noise, &smoothed_covariance);
   stats.smoother_outliers =
       static_cast<int>(std::count(nodes.outlier.begin(), nodes.outlier.end(), true));
-  stats.smoother_sigma_scale_h = nodes.sigma_scale_h;
-  stats.smoother_sigma_scale_v = nodes.sigma_scale_v;
+  stats.smoother_sigma_scale = nodes.sigma_scale;
   stats.ms_smoothing = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 

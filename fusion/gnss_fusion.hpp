@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -97,7 +98,8 @@ struct FusionStats {
   std::vector<FixOutcome> fixes;   // every screened fix in time order (maps, plots)
   double ms_smoothing = 0.0;       // the offline smoothing pass (graph mode), 0 when not run
   int smoother_outliers = 0;       // fixes the smoother left out (SmootherConfig::learn_noise)
-  double smoother_sigma_scale_h = 1.0, smoother_sigma_scale_v = 1.0;  // learned, on the sigmas
+  // Per fix quality: the factors the smoother learned for the stated sigmas (horizontal, vertical).
+  std::map<int, Eigen::Vector2d> smoother_sigma_scale;
 };
 
 class GnssFusion {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -76,9 +77,9 @@ struct SmootherSolve {
 };
 
 SmootherSolve solveOnce(const std::vector<SmootherFix>& fixes, const std::vector<bool>& use,
-                        double scale_h, double scale_v, const Eigen::Vector3d& lever_arm_b,
-                        const RelativeNoise& noise, double huber_sigmas,
-                        const SmootherConfig& config, double tilt_sigma_rad) {
+                        const std::vector<Eigen::Vector2d>& scale,
+                        const Eigen::Vector3d& lever_arm_b, const RelativeNoise& noise,
+                        double huber_sigmas, const SmootherConfig& config, double tilt_sigma_rad) {
   const std::size_t n = fixes.size();
   // Every parameter block in one buffer, poses then biases: ceres::Covariance orders the blocks
   // by address, and two separate allocations came in either order from run to run (measured: the
@@ -102,7 +103,7 @@ SmootherSolve solveOnce(const std::vector<SmootherFix>& fixes, const std::vector
   std::vector<std::unique_ptr<ceres::CostFunction>> left_out;
   for (std::size_t k = 0; k < n; ++k) {
     const SmootherFix& f = fixes[k];
-    const double sigma_h = f.sigma_h_m * scale_h, sigma_v = f.sigma_v_m * scale_v;
+    const double sigma_h = f.sigma_h_m * scale[k].x(), sigma_v = f.sigma_v_m * scale[k].y();
     odometry::poseToBlock(f.T_enu_b, poses[k]);
     problem.AddParameterBlock(poses[k], odometry::kPoseAmbient, &manifold);
     if (with_bias) problem.AddParameterBlock(biases[k], 3);
@@ -138,7 +139,7 @@ SmootherSolve solveOnce(const std::vector<SmootherFix>& fixes, const std::vector
   if (with_bias && n > 0) {
     // The stationary distribution of the bias at the first fix: N(0, sigma^2 I).
     const Eigen::Matrix3d A =
-        Eigen::Matrix3d::Identity() / (config.bias_ratio * fixes.front().sigma_h_m * scale_h);
+        Eigen::Matrix3d::Identity() / (config.bias_ratio * fixes.front().sigma_h_m * scale[0].x());
     problem.AddResidualBlock(new ceres::NormalPrior(A, Eigen::Vector3d::Zero()), nullptr,
                              biases[0]);
   }
@@ -164,6 +165,21 @@ double robustSpread(std::vector<double> values) {
   return 1.4826 * *mid;
 }
 
+// The robust spread (1.4826 MAD about zero) of the used fixes' whitened residuals, horizontal
+// (east and north) and vertical, over the fixes `in_group` selects.
+template <typename InGroup>
+Eigen::Vector2d residualSpread(const SmootherSolve& solve, const std::vector<bool>& use,
+                               InGroup in_group) {
+  std::vector<double> h, v;
+  for (std::size_t k = 0; k < use.size(); ++k) {
+    if (!use[k] || !in_group(k)) continue;
+    h.push_back(std::abs(solve.residual[k].x()));
+    h.push_back(std::abs(solve.residual[k].y()));
+    v.push_back(std::abs(solve.residual[k].z()));
+  }
+  return {robustSpread(h), robustSpread(v)};
+}
+
 }  // namespace
 
 SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Vector3d& lever_arm_b,
@@ -171,50 +187,54 @@ SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Ve
                           const SmootherConfig& config, double tilt_sigma_rad) {
   const std::size_t n = fixes.size();
   std::vector<bool> use(n, true);
-  double scale_h = 1.0, scale_v = 1.0;
+  std::vector<Eigen::Vector2d> scale(n, Eigen::Vector2d::Ones());
+  std::map<int, Eigen::Vector2d> quality_scale;
+  for (const SmootherFix& f : fixes) quality_scale.emplace(f.quality, Eigen::Vector2d::Ones());
   SmootherSolve solve;
   for (int round = 0;; ++round) {
-    solve = solveOnce(fixes, use, scale_h, scale_v, lever_arm_b, noise, huber_sigmas, config,
-                      tilt_sigma_rad);
+    solve = solveOnce(fixes, use, scale, lever_arm_b, noise, huber_sigmas, config, tilt_sigma_rad);
     const auto used = static_cast<int>(std::count(use.begin(), use.end(), true));
     if (!config.learn_noise || round + 1 >= config.max_rounds || used < config.min_fixes_to_learn) {
       break;
     }
-    // The spread of the used fixes' whitened residuals, horizontal (east and north) and vertical.
-    std::vector<double> h, v;
-    for (std::size_t k = 0; k < n; ++k) {
-      if (!use[k]) continue;
-      h.push_back(std::abs(solve.residual[k].x()));
-      h.push_back(std::abs(solve.residual[k].y()));
-      v.push_back(std::abs(solve.residual[k].z()));
+    // Each quality's spread, or every fix's where a quality has too few to tell.
+    const Eigen::Vector2d pooled = residualSpread(solve, use, [](std::size_t) { return true; });
+    std::map<int, Eigen::Vector2d> spread;
+    for (const auto& [quality, unused] : quality_scale) {
+      const auto of_quality = [&](std::size_t k) { return fixes[k].quality == quality; };
+      int count = 0;
+      for (std::size_t k = 0; k < n; ++k) count += use[k] && of_quality(k) ? 1 : 0;
+      spread[quality] =
+          count >= config.min_fixes_to_learn ? residualSpread(solve, use, of_quality) : pooled;
     }
-    const double spread_h = robustSpread(h), spread_v = robustSpread(v);
-    const double detect_h = std::max(spread_h, config.min_learned_scale);
-    const double detect_v = std::max(spread_v, config.min_learned_scale);
+    const std::vector<bool> solved_with = use;
     bool changed = false;
     for (std::size_t k = 0; k < n; ++k) {
+      const Eigen::Vector2d detect = spread[fixes[k].quality].cwiseMax(config.min_learned_scale);
       const Eigen::Vector3d& r = solve.residual[k];
-      const double d2 = (r.x() * r.x() + r.y() * r.y()) / (detect_h * detect_h) +
-                        r.z() * r.z() / (detect_v * detect_v);
+      const double d2 = (r.x() * r.x() + r.y() * r.y()) / (detect.x() * detect.x()) +
+                        r.z() * r.z() / (detect.y() * detect.y());
       const bool inlier = d2 <= config.outlier_chi2;
       if (inlier != use[k]) changed = true;
       use[k] = inlier;
     }
-    if (std::count(use.begin(), use.end(), true) < 2) {  // nothing left to smooth with: keep all
-      std::fill(use.begin(), use.end(), true);
+    if (std::count(use.begin(), use.end(), true) < 2) {  // nothing left to smooth with
+      use = solved_with;
       break;
     }
-    const double next_h = scale_h * std::max(1.0, spread_h);
-    const double next_v = scale_v * std::max(1.0, spread_v);
-    if (!changed && next_h == scale_h && next_v == scale_v) break;
-    scale_h = next_h;
-    scale_v = next_v;
+    bool rescaled = false;
+    for (auto& [quality, s] : quality_scale) {
+      const Eigen::Vector2d next = s.cwiseProduct(spread[quality].cwiseMax(1.0));
+      rescaled = rescaled || next != s;
+      s = next;
+    }
+    if (!changed && !rescaled) break;
+    for (std::size_t k = 0; k < n; ++k) scale[k] = quality_scale[fixes[k].quality];
   }
   SmoothedNodes out = std::move(solve.nodes);
   out.outlier.resize(n);
   for (std::size_t k = 0; k < n; ++k) out.outlier[k] = !use[k];
-  out.sigma_scale_h = scale_h;
-  out.sigma_scale_v = scale_v;
+  out.sigma_scale = quality_scale;
   return out;
 }
 

@@ -14,6 +14,7 @@
 // correlated error is taken for truth by every fix it touches.
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <map>
 #include <vector>
 
 #include "odometry/trajectory.hpp"
@@ -29,13 +30,15 @@ struct SmootherConfig {
   double bias_tau_s = 60.0;
   int max_iterations = 50;
   // What the fixes say of themselves, learned after a first solve from their residuals against
-  // the smoothed trajectory (the VIO shape plus the slow bias): with at least min_fixes_to_learn
-  // fixes, the robust spread of the whitened residuals (1.4826 MAD, horizontal and vertical
-  // apart) scales the sigmas up where they were optimistic (never down: a correlated error hides
-  // in small residuals), and a fix whose residual lies beyond outlier_chi2 (3 degrees of freedom,
-  // 99.9 %) of that spread is left out (a multipath burst, a wrong RTK fix), then the solve is
-  // repeated, up to max_rounds. The spread used to find outliers is at least min_learned_scale of
-  // the stated sigmas: stated sigmas far too pessimistic still leave a margin.
+  // the smoothed trajectory (the VIO shape plus the slow bias), per fix quality (an RTK fixed and
+  // a float solution state their sigmas differently well): with at least min_fixes_to_learn
+  // fixes of a quality (fewer: those of every quality together), the robust spread of the whitened
+  // residuals (1.4826 MAD, horizontal and vertical apart) scales the sigmas up where they were
+  // optimistic (never down: a correlated error hides in small residuals), and a fix whose residual
+  // lies beyond outlier_chi2 (3 degrees of freedom, 99.9 %) of that spread is left out (a multipath
+  // burst, a wrong RTK fix), then the solve is repeated, up to max_rounds. The spread used to find
+  // outliers is at least min_learned_scale of the stated sigmas: stated sigmas far too pessimistic
+  // still leave a margin.
   bool learn_noise = true;
   int min_fixes_to_learn = 10;
   double outlier_chi2 = 16.27;
@@ -51,6 +54,7 @@ struct SmootherFix {
   Eigen::Isometry3d T_enu_b = Eigen::Isometry3d::Identity();  // online estimate (initial guess)
   Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();            // antenna position of the fix
   double sigma_h_m = 1.0, sigma_v_m = 1.0;
+  int quality = 1;  // NMEA GGA fix quality: the noise is learned per quality
 };
 
 // The VIO relative-motion noise between nodes: sigma = fraction * distance + floor (rotation:
@@ -74,9 +78,10 @@ struct RelativeNoise {
 using PoseCovariance = Eigen::Matrix<double, 6, 6>;
 
 struct SmoothedNodes {
-  std::vector<Eigen::Isometry3d> T_enu_b;           // at each fix, same order
-  std::vector<bool> outlier;                        // per fix: left out by the learned noise
-  double sigma_scale_h = 1.0, sigma_scale_v = 1.0;  // applied to the stated sigmas
+  std::vector<Eigen::Isometry3d> T_enu_b;  // at each fix, same order
+  std::vector<bool> outlier;               // per fix: left out by the learned noise
+  // Per fix quality: the factors applied to the stated sigmas (horizontal, vertical).
+  std::map<int, Eigen::Vector2d> sigma_scale;
   // Marginal covariance of each node (ceres::Covariance, sparse QR); empty when the solve's
   // Jacobian was too ill-conditioned to invert (then no covariance is reported, never a guess).
   std::vector<PoseCovariance> covariance;

@@ -165,6 +165,15 @@ void writeGeoreferencedOutputs(const std::filesystem::path& out, const GnssRunRe
   io::writeTextAtomic(out / "georef.json", j.dump(2) + "\n");
 }
 
+// {"quality 1": {"horizontal": ..., "vertical": ...}, ...}: the smoother's learned factors.
+nlohmann::json sigmaScaleJson(const std::map<int, Eigen::Vector2d>& scale) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [quality, s] : scale) {
+    j[std::to_string(quality)] = {{"horizontal", s.x()}, {"vertical", s.y()}};
+  }
+  return j;
+}
+
 nlohmann::json gnssReport(const GnssRunResult& r, std::size_t fixes_in_dataset) {
   const TimingSummary cost = summarizeTimings(r.stats.ms_per_fix);
   return {{"mode", fusion::toString(r.mode)},
@@ -183,9 +192,7 @@ nlohmann::json gnssReport(const GnssRunResult& r, std::size_t fixes_in_dataset) 
           {"smoothed", r.smoothed},
           {"ms_smoothing", r.stats.ms_smoothing},
           {"smoother_outliers", r.stats.smoother_outliers},
-          {"smoother_sigma_scale",
-           {{"horizontal", r.stats.smoother_sigma_scale_h},
-            {"vertical", r.stats.smoother_sigma_scale_v}}},
+          {"smoother_sigma_scale", sigmaScaleJson(r.stats.smoother_sigma_scale)},
           {"position_sigma_m", positionSigma(r.fused_covariance)},
           {"poses_before_registration", r.stats.poses_before_alignment},
           {"ms_per_fix", {{"mean", cost.mean}, {"p95", cost.p95}, {"max", cost.max}}},

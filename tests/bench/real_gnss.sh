@@ -43,7 +43,7 @@ fi
 
 # "lat,lon,h" of a run's ENU frame (georef.json enu_origin).
 run_origin() {
-  python3 -c 'import json,sys; o=json.load(open(sys.argv[1]))["enu_origin"]; print(f"{o[\"lat_deg\"]!r},{o[\"lon_deg\"]!r},{o[\"h_ellipsoid_m\"]!r}")' "$1/georef.json"
+  python3 -c 'import json,sys; o=json.load(open(sys.argv[1]))["enu_origin"]; print(",".join(repr(o[k]) for k in ("lat_deg", "lon_deg", "h_ellipsoid_m")))' "$1/georef.json"
 }
 
 evaluate() {  # evaluate RUN_DIR FILE NAME ORIGIN WINDOW_CSV

@@ -112,14 +112,16 @@ TEST(GnssSmoother, LearnsOptimisticSigmas) {
   const Fused a = fuse(d, learn);
   const Fused b = fuse(d, stated);
   const double learned = rmse(d.truth, a.smoothed), as_stated = rmse(d.truth, b.smoothed);
-  std::printf("learned: %.3f m (sigmas x %.2f h, %.2f v), as stated: %.3f m\n", learned,
-              a.stats.smoother_sigma_scale_h, a.stats.smoother_sigma_scale_v, as_stated);
+  ASSERT_EQ(a.stats.smoother_sigma_scale.size(), 1U);  // every fix of quality 1
+  const Eigen::Vector2d scale = a.stats.smoother_sigma_scale.at(1);
+  std::printf("learned: %.3f m (sigmas x %.2f h, %.2f v), as stated: %.3f m\n", learned, scale.x(),
+              scale.y(), as_stated);
   EXPECT_LT(learned, 0.95 * as_stated);
   EXPECT_LT(learned, 1.3);
-  EXPECT_GT(a.stats.smoother_sigma_scale_h, 2.0);
-  EXPECT_LT(a.stats.smoother_sigma_scale_h, 3.5);
-  EXPECT_GT(a.stats.smoother_sigma_scale_v, 2.0);
-  EXPECT_EQ(b.stats.smoother_sigma_scale_h, 1.0);
+  EXPECT_GT(scale.x(), 2.0);
+  EXPECT_LT(scale.x(), 3.5);
+  EXPECT_GT(scale.y(), 2.0);
+  EXPECT_EQ(b.stats.smoother_sigma_scale.at(1), Eigen::Vector2d::Ones());
 }
 
 // Outliers that reach the smoother (here the online gate lets every fix through, as it does after
