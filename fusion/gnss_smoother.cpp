@@ -200,7 +200,8 @@ SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Ve
     // Each quality's spread, or every fix's where a quality has too few to tell.
     const Eigen::Vector2d pooled = residualSpread(solve, use, [](std::size_t) { return true; });
     std::map<int, Eigen::Vector2d> spread;
-    for (const auto& [quality, unused] : quality_scale) {
+    for (const auto& entry : quality_scale) {
+      const int quality = entry.first;  // a variable, not a binding: lambdas capture it in C++17
       const auto of_quality = [&](std::size_t k) { return fixes[k].quality == quality; };
       int count = 0;
       for (std::size_t k = 0; k < n; ++k) count += use[k] && of_quality(k) ? 1 : 0;
