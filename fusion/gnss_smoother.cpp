@@ -69,17 +69,30 @@ void SmootherConfig::validate() const {
 
 namespace {
 
+// What every solve of one smoothing pass shares.
+struct SmootherProblem {
+  const std::vector<SmootherFix>& fixes;
+  const Eigen::Vector3d& lever_arm_b;
+  const RelativeNoise& noise;
+  double huber_sigmas;
+  const SmootherConfig& config;
+  double tilt_sigma_rad;
+};
+
 // One batch solve over the fixes with use[k], their sigmas scaled; the whitened residual of
-// every fix (used or not) against the solution, in the scaled sigmas.
+// every fix (used or not) against the solution, in the scaled sigmas; the nodes' covariances
+// only when asked (they cost more than the solve, and only the last solve's are reported).
 struct SmootherSolve {
   SmoothedNodes nodes;
   std::vector<Eigen::Vector3d> residual;
+  bool with_covariance = false;
 };
 
-SmootherSolve solveOnce(const std::vector<SmootherFix>& fixes, const std::vector<bool>& use,
-                        const std::vector<Eigen::Vector2d>& scale,
-                        const Eigen::Vector3d& lever_arm_b, const RelativeNoise& noise,
-                        double huber_sigmas, const SmootherConfig& config, double tilt_sigma_rad) {
+SmootherSolve solveOnce(const SmootherProblem& in, const std::vector<bool>& use,
+                        const std::vector<Eigen::Vector2d>& scale, bool with_covariance) {
+  const std::vector<SmootherFix>& fixes = in.fixes;
+  const Eigen::Vector3d& lever_arm_b = in.lever_arm_b;
+  const SmootherConfig& config = in.config;
   const std::size_t n = fixes.size();
   // Every parameter block in one buffer, poses then biases: ceres::Covariance orders the blocks
   // by address, and two separate allocations came in either order from run to run (measured: the
@@ -92,7 +105,7 @@ SmootherSolve solveOnce(const std::vector<SmootherFix>& fixes, const std::vector
   }
   const bool with_bias = config.bias_ratio > 0.0;
   odometry::PoseManifold manifold;
-  ceres::HuberLoss loss(huber_sigmas);
+  ceres::HuberLoss loss(in.huber_sigmas);
   ceres::Problem::Options popts;
   popts.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   popts.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -107,9 +120,9 @@ SmootherSolve solveOnce(const std::vector<SmootherFix>& fixes, const std::vector
     odometry::poseToBlock(f.T_enu_b, poses[k]);
     problem.AddParameterBlock(poses[k], odometry::kPoseAmbient, &manifold);
     if (with_bias) problem.AddParameterBlock(biases[k], 3);
-    if (tilt_sigma_rad > 0.0) {
+    if (in.tilt_sigma_rad > 0.0) {
       const Eigen::Vector3d g_b = f.T_w_b.rotation().transpose() * Eigen::Vector3d::UnitZ();
-      problem.AddResidualBlock(new TiltFactor(g_b, tilt_sigma_rad), nullptr, poses[k]);
+      problem.AddResidualBlock(new TiltFactor(g_b, in.tilt_sigma_rad), nullptr, poses[k]);
     }
     if (with_bias) {
       fix_factors[k] = new GnssBiasedPositionFactor(lever_arm_b, f.p_enu, sigma_h, sigma_v);
@@ -126,9 +139,9 @@ SmootherSolve solveOnce(const std::vector<SmootherFix>& fixes, const std::vector
     if (k == 0) continue;
     const Eigen::Isometry3d T_rel = fixes[k - 1].T_w_b.inverse() * f.T_w_b;
     const double dist = T_rel.translation().norm();
-    problem.AddResidualBlock(
-        new RelativePoseFactor(T_rel, noise.rotationSigmaRad(dist), noise.positionSigmaM(dist)),
-        nullptr, poses[k - 1], poses[k]);
+    problem.AddResidualBlock(new RelativePoseFactor(T_rel, in.noise.rotationSigmaRad(dist),
+                                                    in.noise.positionSigmaM(dist)),
+                             nullptr, poses[k - 1], poses[k]);
     if (with_bias) {
       const double dt = static_cast<double>(f.t_ns - fixes[k - 1].t_ns) * 1e-9;
       problem.AddResidualBlock(
@@ -149,7 +162,8 @@ SmootherSolve solveOnce(const std::vector<SmootherFix>& fixes, const std::vector
   SmootherSolve out;
   out.nodes.T_enu_b.reserve(n);
   for (const double* p : poses) out.nodes.T_enu_b.push_back(odometry::poseFromBlock(p));
-  out.nodes.covariance = nodeCovariances(problem, poses);
+  if (with_covariance) out.nodes.covariance = nodeCovariances(problem, poses);
+  out.with_covariance = with_covariance;
   out.residual.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     const double* blocks[2] = {poses[k], biases[k]};
@@ -185,6 +199,7 @@ Eigen::Vector2d residualSpread(const SmootherSolve& solve, const std::vector<boo
 SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Vector3d& lever_arm_b,
                           const RelativeNoise& noise, double huber_sigmas,
                           const SmootherConfig& config, double tilt_sigma_rad) {
+  const SmootherProblem problem{fixes, lever_arm_b, noise, huber_sigmas, config, tilt_sigma_rad};
   const std::size_t n = fixes.size();
   std::vector<bool> use(n, true);
   std::vector<Eigen::Vector2d> scale(n, Eigen::Vector2d::Ones());
@@ -192,11 +207,11 @@ SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Ve
   for (const SmootherFix& f : fixes) quality_scale.emplace(f.quality, Eigen::Vector2d::Ones());
   SmootherSolve solve;
   for (int round = 0;; ++round) {
-    solve = solveOnce(fixes, use, scale, lever_arm_b, noise, huber_sigmas, config, tilt_sigma_rad);
     const auto used = static_cast<int>(std::count(use.begin(), use.end(), true));
-    if (!config.learn_noise || round + 1 >= config.max_rounds || used < config.min_fixes_to_learn) {
-      break;
-    }
+    const bool last =
+        !config.learn_noise || round + 1 >= config.max_rounds || used < config.min_fixes_to_learn;
+    solve = solveOnce(problem, use, scale, last);
+    if (last) break;
     // Each quality's spread, or every fix's where a quality has too few to tell.
     const Eigen::Vector2d pooled = residualSpread(solve, use, [](std::size_t) { return true; });
     std::map<int, Eigen::Vector2d> spread;
@@ -232,6 +247,9 @@ SmoothedNodes smoothNodes(const std::vector<SmootherFix>& fixes, const Eigen::Ve
     if (!changed && !rescaled) break;
     for (std::size_t k = 0; k < n; ++k) scale[k] = quality_scale[fixes[k].quality];
   }
+  // Learning settled (or found too few fixes to go on) before the last round: the same solve
+  // again, for its covariances.
+  if (!solve.with_covariance) solve = solveOnce(problem, use, scale, true);
   SmoothedNodes out = std::move(solve.nodes);
   out.outlier.resize(n);
   for (std::size_t k = 0; k < n; ++k) out.outlier[k] = !use[k];
