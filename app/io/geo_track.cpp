@@ -2,11 +2,9 @@
 
 #include <cctype>
 
-#include "io/euroc.hpp"
+#include "io/gnss_file.hpp"
 #include "io/input_error.hpp"
-#include "io/nmea.hpp"
 #include "io/reference_csv.hpp"
-#include "io/rtklib_pos.hpp"
 #include "io/text.hpp"
 
 namespace gvio::io {
@@ -48,23 +46,15 @@ std::string geoTrackFormat(const std::filesystem::path& file) {
 GeoTrack readGeoTrack(const std::filesystem::path& file, const ReaderConfig& config) {
   const std::string format = geoTrackFormat(file);
   GeoTrack track;
-  if (format == "nmea") {
-    NmeaLog log = readNmea(file, config);
-    track = fromFixes(log.fixes, true);
-    track.warnings = std::move(log.warnings);
-  } else if (format == "rtklib-pos") {
-    PosFile pos = readRtklibPos(file, config);
-    track = fromFixes(pos.fixes, true);
-    track.warnings = std::move(pos.warnings);
-  } else if (format == "gnss-csv") {
-    std::vector<std::string> warnings;
-    track = fromFixes(readGnssCsv(file, warnings), false);
-    track.warnings = std::move(warnings);
-  } else if (format == "reference-csv") {
+  if (format == "reference-csv") {
     for (const ReferenceEpoch& e : readReferenceCsv(file).epochs) {
       track.t_ns.push_back(e.t_ns);
       track.lla.push_back(e.lla);
     }
+  } else if (!format.empty()) {  // the GNSS solution readers, as --gnss-file reads them
+    GnssFileData data = readGnssFile(file, config);
+    track = fromFixes(data.fixes, format != "gnss-csv");  // the CSV states no quality
+    track.warnings = std::move(data.warnings);
   } else {
     throw InputError(file, 0,
                      "not a GNSS solution (NMEA, RTKLIB .pos, GNSS CSV) nor a reference CSV");
