@@ -27,18 +27,6 @@ double seconds(std::int64_t dt_ns) {
   return static_cast<double>(dt_ns) * 1e-9;
 }
 
-// Body -> ENU rotation from the body's up direction (unit, body frame) and the heading of the
-// body x axis (rad, counter-clockwise from east): R = Rz(yaw) Ry(pitch) Rx(roll), with
-// R^T e_up = (-sin pitch, cos pitch sin roll, cos pitch cos roll).
-Eigen::Matrix3d rotationFromUpAndYaw(const Eigen::Vector3d& up_b, double yaw_rad) {
-  const double pitch = std::asin(std::clamp(-up_b.x(), -1.0, 1.0));
-  const double roll = std::atan2(up_b.y(), up_b.z());
-  return (Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
-}
-
 }  // namespace
 
 void InsConfig::validate() const {
@@ -71,6 +59,23 @@ void InsConfig::validate() const {
   requirePositive(init_acc_bias_sigma_mps2, "fusion.ins.init_acc_bias_sigma_mps2");
   requirePositive(init_gyr_bias_sigma_radps, "fusion.ins.init_gyr_bias_sigma_radps");
   requirePositive(max_imu_gap_s, "fusion.ins.max_imu_gap_s");
+  requirePositive(mount.min_speed_mps, "fusion.ins.mount_min_speed_mps");
+  if (mount.min_samples < 3)
+    throw InvalidInput("config: fusion.ins.mount_min_samples must be >= 3");
+  if (!(mount.min_concentration > 0.0 && mount.min_concentration <= 1.0)) {
+    throw InvalidInput("config: fusion.ins.mount_min_concentration must be in (0, 1]");
+  }
+  requirePositive(align.chunk_s, "fusion.ins.align_chunk_s");
+  requirePositive(align.max_window_s, "fusion.ins.align_max_window_s");
+  if (!(align.max_window_s > align.chunk_s)) {
+    throw InvalidInput(
+        "config: fusion.ins.align_max_window_s must exceed fusion.ins.align_chunk_s");
+  }
+  requirePositive(align.max_heading_sigma_deg, "fusion.ins.align_max_heading_sigma_deg");
+  requirePositive(align.min_speed_mps, "fusion.ins.align_min_speed_mps");
+  requirePositive(align.quiet_gyro_std_radps, "fusion.ins.align_quiet_gyro_std_radps");
+  requirePositive(align.quiet_gyro_mean_radps, "fusion.ins.align_quiet_gyro_mean_radps");
+  requirePositive(align.quiet_acc_mps2, "fusion.ins.align_quiet_acc_mps2");
 }
 
 std::optional<Eigen::Vector2d> fixVelocityEn(const GnssFix& fix) {
@@ -81,13 +86,13 @@ std::optional<Eigen::Vector2d> fixVelocityEn(const GnssFix& fix) {
   return Eigen::Vector2d(fix.speed_mps * std::sin(course), fix.speed_mps * std::cos(course));
 }
 
-GnssIns::GnssIns(const InsConfig& config, const EnuFrame& enu) : config_(config), enu_(enu) {
+GnssIns::GnssIns(const InsConfig& config, const EnuFrame& enu)
+    : config_(config), enu_(enu), mount_estimator_(config.mount) {
   config_.validate();
-  const Eigen::Vector3d rpy = config_.mount_rpy_deg * kDegToRad;
-  R_v_b_ = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
-            Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
-            Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
-               .toRotationMatrix();
+  R_v_b_config_ = mountRotation(config_.mount_rpy_deg * kDegToRad);
+  R_v_b_ = R_v_b_config_;
+  estimate_mount_ = config_.estimate_mount && config_.mount_rpy_deg.isZero(0.0);
+  mount_known_ = !estimate_mount_;
   x_.time_offset_s = config_.receiver_time_offset_s;
 }
 
@@ -106,14 +111,14 @@ void GnssIns::recordPose() {
 void GnssIns::addImu(const ImuSample& s) {
   ++stats_.imu_samples;
   if (last_imu_ && s.t_ns <= last_imu_->t_ns) return;  // readers guarantee increasing stamps
-  if (!initialized_) {
-    ++stats_.imu_before_init;
-    init_imu_.push_back(s);
-    const auto window_ns = static_cast<std::int64_t>(config_.init_window_s * 1e9);
-    while (init_imu_.front().t_ns < s.t_ns - window_ns) init_imu_.pop_front();
-    last_imu_ = s;
-    return;
+  if (initialized_) {
+    propagate(s);
+  } else {
+    bufferImu(s);
   }
+}
+
+void GnssIns::propagate(const ImuSample& s) {
   const double dt = seconds(s.t_ns - last_imu_->t_ns);
   if (dt > config_.max_imu_gap_s) ++stats_.imu_gaps;
   // The previous sample is held over [t_prev, t] (zero-order hold).
@@ -133,80 +138,27 @@ void GnssIns::addFix(const GnssFix& fix) {
   if (!initialized_) {
     tryInitialize(fix, p_ant);
   } else {
-    updatePosition(fix, p_ant);
-    if (config_.use_velocity) updateVelocity(fix);
-    if (config_.use_nhc) updateNonHolonomic();
+    processFix(fix, p_ant);
   }
   prev_fix_ = std::make_pair(fix.t_ns, p_ant);
   stats_.ms_per_fix.push_back(
       std::chrono::duration<double, std::milli>(Clock::now() - start).count());
 }
 
-void GnssIns::tryInitialize(const GnssFix& fix, const Eigen::Vector3d& p_ant) {
-  std::optional<Eigen::Vector2d> v_en = fixVelocityEn(fix);
-  if (!v_en && prev_fix_) {
-    const double dt = seconds(fix.t_ns - prev_fix_->first);
-    if (dt > 0.0 && dt <= 2.0) v_en = (p_ant - prev_fix_->second).head<2>() / dt;
+void GnssIns::processFix(const GnssFix& fix, const Eigen::Vector3d& p_ant) {
+  updatePosition(fix, p_ant);
+  if (config_.use_velocity) updateVelocity(fix);
+  if (config_.use_nhc && mount_known_) updateNonHolonomic();
+  if (estimate_mount_) updateMount();
+}
+
+void GnssIns::updateMount() {
+  mount_estimator_.add(x_.R_enu_b.transpose() * x_.v_enu_mps);
+  stats_.mount = mount_estimator_.estimate(R_v_b_config_);
+  if (stats_.mount) {
+    R_v_b_ = stats_.mount->R_v_b;
+    mount_known_ = true;
   }
-  const auto window_ns = static_cast<std::int64_t>(config_.init_window_s * 1e9);
-  if (v_en) init_fix_v_.push_back({fix.t_ns, *v_en});
-  while (!init_fix_v_.empty() && init_fix_v_.front().t_ns < fix.t_ns - window_ns) {
-    init_fix_v_.pop_front();
-  }
-  const bool moving = v_en && v_en->norm() >= config_.init_min_speed_mps;
-  const bool imu_ready = last_imu_ && init_imu_.size() >= 5 &&
-                         init_imu_.back().t_ns - init_imu_.front().t_ns >= window_ns / 2;
-  if (!moving || !imu_ready) {
-    ++stats_.fixes_before_init;
-    stats_.fixes.push_back({fix.t_ns, p_ant, InsFixStatus::kBeforeInit});
-    return;
-  }
-  // Coarse levelling (Groves section 5.6.2) from the mean specific force f = R^T (a - g), with the
-  // acceleration a over the window taken from the GNSS velocities: up_b = normalise(f - R^T a),
-  // iterated because R itself depends on the tilt.
-  Eigen::Vector3d f_mean = Eigen::Vector3d::Zero();
-  for (const ImuSample& s : init_imu_) f_mean += s.acc_b_mps2;
-  f_mean /= static_cast<double>(init_imu_.size());
-  Eigen::Vector3d a_enu = Eigen::Vector3d::Zero();
-  const FixVelocity& oldest = init_fix_v_.front();
-  const double span_s = seconds(fix.t_ns - oldest.t_ns);
-  if (span_s >= 0.3 * config_.init_window_s) a_enu.head<2>() = (*v_en - oldest.v_en) / span_s;
-  const double yaw = std::atan2(v_en->y(), v_en->x());  // the body x axis along the course
-  Eigen::Vector3d up_b = f_mean.normalized();
-  Eigen::Matrix3d R = rotationFromUpAndYaw(up_b, yaw);
-  for (int i = 0; i < 3; ++i) {
-    up_b = (f_mean - R.transpose() * a_enu).normalized();
-    R = rotationFromUpAndYaw(up_b, yaw);
-  }
-  x_.R_enu_b = R;
-  x_.v_enu_mps = Eigen::Vector3d(v_en->x(), v_en->y(), 0.0);
-  x_.p_enu = p_ant - R * config_.lever_arm_b -
-             x_.v_enu_mps * (stampMinusFilter(fix.t_ns) + x_.time_offset_s);
-  P_.setZero();
-  P_.block<3, 3>(kInsP, kInsP).diagonal() << fix.sigma_h_m * fix.sigma_h_m,
-      fix.sigma_h_m * fix.sigma_h_m, fix.sigma_v_m * fix.sigma_v_m;
-  P_.block<3, 3>(kInsV, kInsV).diagonal().setConstant(std::pow(config_.init_velocity_sigma_mps, 2));
-  // Tilt and heading sigmas are about ENU axes; the error angle is in the body (local) frame.
-  const double tilt = config_.init_tilt_sigma_deg * kDegToRad;
-  const double heading = config_.init_heading_sigma_deg * kDegToRad;
-  const Eigen::Vector3d att_var(tilt * tilt, tilt * tilt, heading * heading);
-  P_.block<3, 3>(kInsTheta, kInsTheta) = R.transpose() * att_var.asDiagonal() * R;
-  P_.block<3, 3>(kInsBa, kInsBa)
-      .diagonal()
-      .setConstant(std::pow(config_.init_acc_bias_sigma_mps2, 2));
-  P_.block<3, 3>(kInsBg, kInsBg)
-      .diagonal()
-      .setConstant(std::pow(config_.init_gyr_bias_sigma_radps, 2));
-  P_(kInsTau, kInsTau) =
-      config_.estimate_time_offset ? std::pow(config_.time_offset_sigma_s, 2) : 0.0;
-  initialized_ = true;
-  stats_.t_init_ns = last_imu_->t_ns;
-  last_accepted_ns_ = fix.t_ns;
-  ++stats_.fixes_used;
-  stats_.fixes.push_back({fix.t_ns, p_ant, InsFixStatus::kUsed});
-  init_imu_.clear();
-  init_fix_v_.clear();
-  recordPose();
 }
 
 template <int Rows>
@@ -288,6 +240,7 @@ void GnssIns::updateNonHolonomic() {
 }
 
 void GnssIns::finish() {
+  if (!initialized_) flushPendingBeforeInit();
   if (!initialized_ || !last_accepted_ns_ || !last_imu_) return;
   if (seconds(last_imu_->t_ns - *last_accepted_ns_) > config_.outage_s) {
     stats_.outages.emplace_back(*last_accepted_ns_, last_imu_->t_ns);

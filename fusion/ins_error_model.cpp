@@ -1,5 +1,9 @@
 #include "fusion/ins_error_model.hpp"
 
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
 #include "odometry/lie.hpp"
 
 namespace gvio::fusion {
@@ -12,6 +16,15 @@ using odometry::rightJacobianSo3;
 
 Eigen::Vector3d gravityEnu() {
   return {0.0, 0.0, -kGravity_mps2};
+}
+
+Eigen::Matrix3d rotationFromUpAndYaw(const Eigen::Vector3d& up_b, double yaw_rad) {
+  const double pitch = std::asin(std::clamp(-up_b.x(), -1.0, 1.0));
+  const double roll = std::atan2(up_b.y(), up_b.z());
+  return (Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
 }
 
 InsState propagateNominal(const InsState& x, const Eigen::Vector3d& acc_b_mps2,

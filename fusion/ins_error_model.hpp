@@ -33,6 +33,12 @@ struct InsState {
 // Gravity in local ENU, g = (0, 0, -kGravity_mps2) as the odometry library uses it.
 Eigen::Vector3d gravityEnu();
 
+// Body -> ENU rotation from the body's up direction (unit, body frame) and the heading of the
+// body x axis (rad, counter-clockwise from east): R = Rz(yaw) Ry(pitch) Rx(roll), with
+// R^T e_up = (-sin pitch, cos pitch sin roll, cos pitch cos roll) (coarse levelling, Groves
+// section 5.6.2).
+Eigen::Matrix3d rotationFromUpAndYaw(const Eigen::Vector3d& up_b, double yaw_rad);
+
 // One step of dt seconds with the IMU sample held constant over it (Sola eq. 260, with the exact
 // rotation increment): R+ = R Exp((w - bg) dt), v+ = v + a dt, p+ = p + v dt + a dt^2 / 2 where
 // a = R (f - ba) + g.

@@ -246,6 +246,35 @@ json gnssInsReport(const io::Dataset& ds, const InsRunResult& r, const InsReport
         {"lon_deg", r.origin.lon_deg},
         {"h_ellipsoid_m", r.origin.h_ellipsoid_m}}}};
   if (!ctx.gnss_noise.is_null()) report["gnss"]["noise_added"] = ctx.gnss_noise;
+  const auto optionalSeconds = [](const std::optional<std::int64_t>& t) {
+    return t ? json(seconds(*t)) : json(nullptr);
+  };
+  report["gnss"]["initialisation"] = {
+      {"method", s.init_method.empty() ? json(nullptr) : json(s.init_method)},
+      {"t_start", optionalSeconds(s.t_init_ns)},
+      {"t_heading_known", optionalSeconds(s.t_heading_ns)},
+      {"heading_sigma_deg", s.t_init_ns ? json(s.init_heading_sigma_deg) : json(nullptr)},
+      {"gyro_bias_from_rest", s.init_quiet_start},
+      {"alignment_restarts", s.alignment_restarts}};
+  if (s.init_method == "track") {
+    report["gnss"]["initialisation"]["mount_yaw_from_turns_deg"] = s.align_mount_yaw_deg;
+    report["gnss"]["initialisation"]["mount_yaw_from_turns_sigma_deg"] =
+        s.align_mount_yaw_sigma_deg;
+  }
+  const Eigen::Vector3d& cfg = r.config.mount_rpy_deg;
+  json mount = {{"configured_rpy_deg", {cfg.x(), cfg.y(), cfg.z()}}};
+  if (s.mount) {
+    const Eigen::Vector3d rpy = s.mount->rpy_rad * 180.0 / M_PI;
+    mount["source"] = "estimated";
+    mount["rpy_deg"] = {rpy.x(), rpy.y(), rpy.z()};
+    mount["epochs"] = s.mount->samples;
+    mount["concentration"] = s.mount->concentration;
+  } else {
+    const bool estimating = r.config.estimate_mount && cfg.isZero(0.0);
+    mount["source"] = estimating ? "not yet estimated" : "config";
+    mount["rpy_deg"] = {cfg.x(), cfg.y(), cfg.z()};
+  }
+  report["gnss"]["mount"] = std::move(mount);
   json outages = json::array();
   for (const auto& [t0, t1] : s.outages) {
     outages.push_back({{"t0", seconds(t0)}, {"t1", seconds(t1)}, {"duration_s", seconds(t1 - t0)}});

@@ -103,11 +103,22 @@ bool runGnssInsInstead(RunState& s) {
         evaluation->raw_3d->rmse);
   }
   const Coverage coverage = insCoverage(ds, r);
+  std::string init = "; not initialised";
+  if (r.stats.t_init_ns) {
+    init = fmt::format("; heading from the {} ({:.1f} deg)",
+                       r.stats.init_method == "track" ? "track alignment" : "GNSS course",
+                       r.stats.init_heading_sigma_deg);
+  }
+  if (r.stats.mount) {
+    const Eigen::Vector3d rpy = r.stats.mount->rpy_rad * 180.0 / M_PI;
+    init +=
+        fmt::format(", mount estimated rpy {:.1f} {:.1f} {:.1f} deg", rpy.x(), rpy.y(), rpy.z());
+  }
   spdlog::info(
       "GNSS/INS: {} fixes used, {} rejected, {} before init, {} outage(s), time offset {:.3f} +- "
-      "{:.3f} s{}{}; wrote {}",
+      "{:.3f} s{}{}{}; wrote {}",
       r.stats.fixes_used, r.stats.fixes_rejected, r.stats.fixes_before_init, r.stats.outages.size(),
-      r.final_state.time_offset_s, r.time_offset_sigma_s, figures, partialNote(coverage),
+      r.final_state.time_offset_s, r.time_offset_sigma_s, init, figures, partialNote(coverage),
       out.string());
   return true;
 }
