@@ -18,6 +18,9 @@ using Clock = std::chrono::steady_clock;
 constexpr double kKfGateChi2 = 22.46;
 // A fix without a usable previous one gets no velocity information (variance in (m/s)^2).
 constexpr double kNoVelocityVariance = 1e8;
+// Consecutive fixes further apart than this say little about the receiver's white noise (the VIO
+// drifts, the receiver's slow error decorrelates).
+constexpr double kMaxNoiseDifferencingS = 2.0;
 
 }  // namespace
 
@@ -208,11 +211,22 @@ bool GnssFusion::Impl::fuseKf(const Pair& pair) {
   const Eigen::Vector3d& lever = config.lever_arm_b;
   const Eigen::Vector3d p_vio = *T_enu_w * (pair.T_w_b * lever);
   kf.predict(pair.t_ns);
+  // The stated sigmas, scaled by what the earlier fixes of this quality showed.
+  const Eigen::Vector2d scale =
+      config.kf.learn_noise ? kf_noise.scale(pair.fix.quality) : Eigen::Vector2d::Ones();
+  const auto variances = [&](const GnssFix& fix) -> Eigen::Vector3d {
+    const double h = fix.sigma_h_m * scale.x(), v = fix.sigma_v_m * scale.y();
+    return {h * h, h * h, v * v};
+  };
+  const auto stated = [](const GnssFix& fix) -> Eigen::Vector3d {
+    return {fix.sigma_h_m * fix.sigma_h_m, fix.sigma_h_m * fix.sigma_h_m,
+            fix.sigma_v_m * fix.sigma_v_m};
+  };
   KfBaseline::Vector6d z;
   KfBaseline::Matrix6d R = KfBaseline::Matrix6d::Zero();
-  const Eigen::Vector3d var_p(pair.fix.sigma_h_m * pair.fix.sigma_h_m,
-                              pair.fix.sigma_h_m * pair.fix.sigma_h_m,
-                              pair.fix.sigma_v_m * pair.fix.sigma_v_m);
+  const Eigen::Vector3d var_p = variances(pair.fix);
+  double dt_prev = 0.0;
+  GnssFix prev_fix;
   z.head<3>() = pair.p_enu - p_vio;
   R.diagonal().head<3>() = var_p;
   // No Doppler in the input: GNSS velocity by finite differences of consecutive fixes, against the
@@ -224,14 +238,22 @@ bool GnssFusion::Impl::fuseKf(const Pair& pair) {
     if (dt > 0.0) {
       const Eigen::Vector3d p_vio_prev = *T_enu_w * (previous_fix->T_w_b * lever);
       z.tail<3>() = (pair.p_enu - previous_fix->p_enu) / dt - (p_vio - p_vio_prev) / dt;
-      const GnssFix& prev = previous_fix->fix;
-      const Eigen::Vector3d var_prev(prev.sigma_h_m * prev.sigma_h_m,
-                                     prev.sigma_h_m * prev.sigma_h_m,
-                                     prev.sigma_v_m * prev.sigma_v_m);
-      R.diagonal().tail<3>() = (var_p + var_prev) / (dt * dt);
+      R.diagonal().tail<3>() = (var_p + variances(previous_fix->fix)) / (dt * dt);
+      dt_prev = dt;
+      prev_fix = previous_fix->fix;
     }
   }
   previous_fix = pair;
+  // What the receiver's noise is, from consecutive fixes: their displacement against the VIO's
+  // over at most kMaxNoiseDifferencingS, normalised by the stated sigmas of both, is free of the
+  // filter's own error (which would feed back: larger sigmas, a looser filter, larger
+  // innovations) and of the slow bias the differencing cancels.
+  if (config.kf.learn_noise && dt_prev > 0.0 && dt_prev <= kMaxNoiseDifferencingS) {
+    const Eigen::Vector3d both = stated(pair.fix) + stated(prev_fix);
+    const Eigen::Vector3d z2 = (z.tail<3>() * dt_prev).cwiseAbs2().cwiseQuotient(both);
+    kf_noise.add(pair.fix.quality, z2.head<2>(), z2.z());
+    stats.kf_sigma_scale = kf_noise.scales();
+  }
   KfBaseline candidate = kf;
   const double nis = candidate.update(z, R);
   if (nis > kKfGateChi2 && consecutive_rejections < config.max_consecutive_rejections &&

@@ -100,6 +100,8 @@ struct FusionStats {
   int smoother_outliers = 0;       // fixes the smoother left out (SmootherConfig::learn_noise)
   // Per fix quality: the factors the smoother learned for the stated sigmas (horizontal, vertical).
   std::map<int, Eigen::Vector2d> smoother_sigma_scale;
+  // kf mode with fusion.kf.learn_noise: the factors learned online at the end of the drive.
+  std::map<int, Eigen::Vector2d> kf_sigma_scale;
 };
 
 class GnssFusion {

@@ -12,6 +12,7 @@
 #include "fusion/gnss_smoother.hpp"
 #include "fusion/graph_window.hpp"
 #include "fusion/kf_baseline.hpp"
+#include "fusion/online_sigma_scale.hpp"
 
 namespace gvio::fusion {
 
@@ -61,6 +62,7 @@ struct GnssFusion::Impl {
   double registration_tilt_sigma_rad = 0.0;  // ... and the tilt (used without an IMU)
   GraphWindow graph;
   KfBaseline kf;
+  OnlineSigmaScale kf_noise;
   std::int64_t kf_t_ns = 0;
   std::optional<Pair> previous_fix;  // KF: finite-difference GNSS velocity
   int consecutive_rejections = 0;

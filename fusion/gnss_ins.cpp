@@ -8,6 +8,7 @@
 #include <numbers>
 #include <string>
 
+#include "fusion/ins_heading_bank.hpp"
 #include "odometry/error.hpp"
 
 namespace gvio::fusion {
@@ -76,6 +77,12 @@ void InsConfig::validate() const {
   requirePositive(align.quiet_gyro_std_radps, "fusion.ins.align_quiet_gyro_std_radps");
   requirePositive(align.quiet_gyro_mean_radps, "fusion.ins.align_quiet_gyro_mean_radps");
   requirePositive(align.quiet_acc_mps2, "fusion.ins.align_quiet_acc_mps2");
+  if (align.hypotheses != 0 && (align.hypotheses < 4 || align.hypotheses > 72)) {
+    throw InvalidInput("config: fusion.ins.align_hypotheses must be 0 (off) or 4..72");
+  }
+  requirePositive(align.same_solution_deg, "fusion.ins.align_same_solution_deg");
+  requirePositive(align.min_nll_gap, "fusion.ins.align_min_nll_gap");
+  requirePositive(align.bank_max_heading_sigma_deg, "fusion.ins.align_bank_max_heading_sigma_deg");
 }
 
 std::optional<Eigen::Vector2d> fixVelocityEn(const GnssFix& fix) {
@@ -94,6 +101,21 @@ GnssIns::GnssIns(const InsConfig& config, const EnuFrame& enu)
   estimate_mount_ = config_.estimate_mount && config_.mount_rpy_deg.isZero(0.0);
   mount_known_ = !estimate_mount_;
   x_.time_offset_s = config_.receiver_time_offset_s;
+}
+
+GnssIns::GnssIns(GnssIns&&) noexcept = default;
+GnssIns& GnssIns::operator=(GnssIns&&) noexcept = default;
+GnssIns::~GnssIns() = default;
+
+void GnssIns::startAt(const ImuSample& anchor, const InsState& x, const InsMatrix& P) {
+  x_ = x;
+  P_ = P;
+  last_imu_ = anchor;
+  initialized_ = true;
+  stats_.t_init_ns = anchor.t_ns;
+  stats_.t_heading_ns = anchor.t_ns;
+  stats_.init_method = "given";
+  recordPose();
 }
 
 double GnssIns::stampMinusFilter(std::int64_t t_ns) const {
@@ -163,13 +185,17 @@ void GnssIns::updateMount() {
 
 template <int Rows>
 bool GnssIns::update(const InsMeasurement<Rows>& m, const Eigen::Matrix<double, Rows, 1>& z,
-                     const Eigen::Matrix<double, Rows, Rows>& R, double gate_chi2, bool force) {
+                     const Eigen::Matrix<double, Rows, Rows>& R, double gate_chi2, bool force,
+                     double* nll) {
   using MatrixR = Eigen::Matrix<double, Rows, Rows>;
   const Eigen::Matrix<double, Rows, 1> y = z - m.h;
   const MatrixR S = m.H * P_ * m.H.transpose() + R;
   const Eigen::LDLT<MatrixR> ldlt(S);
   if (ldlt.info() != Eigen::Success) return false;
   const double d2 = y.dot(ldlt.solve(y));  // normalised innovation squared (Groves eq. 17.7)
+  if (nll != nullptr) {
+    *nll = std::min(d2, 4.0 * gate_chi2) + ldlt.vectorD().array().log().sum();
+  }
   if (!force && !(d2 <= gate_chi2)) return false;
   // K = P H^T S^-1; Joseph form (Groves eq. 3.88) keeps P symmetric positive definite.
   const Eigen::Matrix<double, kInsDim, Rows> K =
@@ -197,7 +223,10 @@ void GnssIns::updatePosition(const GnssFix& fix, const Eigen::Vector3d& p_ant) {
     const Eigen::Vector3d y = p_ant - m.h;
     P_.block<3, 3>(kInsP, kInsP) += Eigen::Vector3d(y.cwiseAbs2()).asDiagonal();
   }
-  if (!update<3>(m, p_ant, R, config_.gate_chi2, force)) {
+  double nll = 0.0;
+  const bool applied = update<3>(m, p_ant, R, config_.gate_chi2, force, &nll);
+  stats_.position_nll += nll;
+  if (!applied) {
     ++stats_.fixes_rejected;
     ++consecutive_rejections_;
     stats_.fixes.push_back({fix.t_ns, p_ant, InsFixStatus::kRejected});

@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -108,21 +109,30 @@ struct InsStats {
   Eigen::Vector2d nhc_innovation_sum_mps = Eigen::Vector2d::Zero();
   std::optional<std::int64_t> t_init_ns;     // where the trajectory starts
   std::optional<std::int64_t> t_heading_ns;  // when the heading became known
-  std::string init_method;                   // "track" or "course"; "" not initialised
+  // "track" (the alignment's sums), "heading bank", "course"; "" not initialised
+  std::string init_method;
   double init_heading_sigma_deg = 0.0;
   bool init_quiet_start = false;     // the gyro bias came from a quiet anchor window
   double align_mount_yaw_deg = 0.0;  // the track alignment's mount yaw (from turns) and 1-sigma
   double align_mount_yaw_sigma_deg = 0.0;
   int alignment_restarts = 0;          // windows without a heading, started again later
   std::optional<MountEstimate> mount;  // the estimated mount, when estimate_mount
+  // -2 log-likelihood of the position innovations, sum of d2 (capped at 4 x the gate: one
+  // outlier is not a verdict) + log det S: what the heading bank ranks its scouts by.
+  double position_nll = 0.0;
   std::vector<std::pair<std::int64_t, std::int64_t>> outages;  // [t0, t1] without accepted fixes
   std::vector<double> ms_per_fix;                              // update cost of each fix
   std::vector<InsFixOutcome> fixes;                            // every fix given, in time order
 };
 
+class HeadingBank;
+
 class GnssIns {
  public:
   GnssIns(const InsConfig& config, const EnuFrame& enu);
+  GnssIns(GnssIns&&) noexcept;
+  GnssIns& operator=(GnssIns&&) noexcept;
+  ~GnssIns();
 
   // IMU samples and fixes in one time-ordered stream: a fix is given before the first IMU sample
   // later than its stamp. Fixes are applied at the filter time of the last IMU sample (causal).
@@ -130,6 +140,9 @@ class GnssIns {
   void addFix(const GnssFix& fix);
   // Closes the last outage at the last IMU sample.
   void finish();
+  // Starts the filter at `anchor` with this state and covariance instead of initialising it
+  // (the heading bank's scouts, fusion/ins_heading_bank.hpp).
+  void startAt(const ImuSample& anchor, const InsState& x, const InsMatrix& P);
 
   [[nodiscard]] bool initialized() const { return initialized_; }
   [[nodiscard]] const InsState& state() const { return x_; }
@@ -151,10 +164,13 @@ class GnssIns {
   void processFix(const GnssFix& fix, const Eigen::Vector3d& p_ant_enu);
   void tryInitialize(const GnssFix& fix, const Eigen::Vector3d& p_ant_enu);
   [[nodiscard]] bool tryCourseInitialize(const GnssFix& fix, const Eigen::Vector3d& p_ant_enu);
-  void initializeFromAlignment(const AlignmentSolution& solution);
+  void initializeFromAlignment(const AlignmentSolution& solution, const std::string& method);
+  void startBank();  // the scouts, from the anchor, fed what pending_ holds
   // P at initialisation: the fix's position sigmas, the configured velocity, tilt and bias
   // sigmas, this heading sigma.
   void setInitialCovariance(const GnssFix& fix, double heading_sigma_rad);
+  [[nodiscard]] InsMatrix initialCovariance(const GnssFix& fix, const Eigen::Matrix3d& R_enu_b,
+                                            double heading_sigma_rad) const;
   void startAlignment();
   void recordBeforeInit(const GnssFix& fix);
   void flushPendingBeforeInit();
@@ -165,7 +181,8 @@ class GnssIns {
   // Kalman update with gating; returns true when applied.
   template <int Rows>
   bool update(const InsMeasurement<Rows>& m, const Eigen::Matrix<double, Rows, 1>& z,
-              const Eigen::Matrix<double, Rows, Rows>& R, double gate_chi2, bool force);
+              const Eigen::Matrix<double, Rows, Rows>& R, double gate_chi2, bool force,
+              double* nll = nullptr);
   void recordPose();
   [[nodiscard]] double stampMinusFilter(std::int64_t t_ns) const;
 
@@ -177,6 +194,7 @@ class GnssIns {
   bool mount_known_ = false;  // the constraint may be applied
   MountEstimator mount_estimator_;
   std::optional<TrackAlignment> align_;
+  std::unique_ptr<HeadingBank> bank_;  // scouts over headings, while the alignment has none
   std::vector<Event> pending_;  // since the alignment's anchor, replayed once it has a heading
   bool initialized_ = false;
   InsState x_;

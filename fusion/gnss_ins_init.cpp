@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "fusion/gnss_ins.hpp"
+#include "fusion/ins_heading_bank.hpp"
 
 namespace gvio::fusion {
 namespace {
@@ -37,6 +38,7 @@ void GnssIns::flushPendingBeforeInit() {
 
 void GnssIns::startAlignment() {
   flushPendingBeforeInit();
+  bank_.reset();
   align_.emplace(config_.align, std::vector<ImuSample>(init_imu_.begin(), init_imu_.end()),
                  config_.lever_arm_b);
   pending_.emplace_back(init_imu_.back());  // the anchor: where a replay would start
@@ -56,6 +58,7 @@ void GnssIns::bufferImu(const ImuSample& s) {
   }
   align_->addImu(s);
   pending_.emplace_back(s);
+  if (bank_) bank_->addImu(s);
   // The window counts from the end of a quiet start: waiting at rest costs no window.
   const std::optional<std::int64_t> moving = align_->movingSinceNs();
   if (moving && seconds(s.t_ns - *moving) > config_.align.max_window_s && window_ready) {
@@ -68,39 +71,82 @@ void GnssIns::tryInitialize(const GnssFix& fix, const Eigen::Vector3d& p_ant) {
   if (align_) {
     pending_.emplace_back(fix);
     align_->addFix(fix.t_ns, p_ant, fix.sigma_h_m);
+    if (bank_) {
+      bank_->addFix(fix);
+    } else if (config_.align.hypotheses > 0) {
+      startBank();
+    }
     if (const std::optional<AlignmentSolution> solution = align_->solve()) {
-      initializeFromAlignment(*solution);
+      initializeFromAlignment(*solution, "track");
       return;
+    }
+    const double max_sigma = config_.align.bank_max_heading_sigma_deg * kDegToRad;
+    if (const std::optional<HeadingChoice> choice =
+            bank_ ? bank_->choose(max_sigma) : std::nullopt) {
+      // The levelled frame's yaw: the winner's attitude now against the gyros' from the anchor.
+      const Eigen::Matrix3d R = choice->R_enu_b * align_->attitudeNow().transpose();
+      const double psi = std::atan2(R(1, 0), R(0, 0));
+      if (const auto solution = align_->solutionWithHeading(psi, choice->sigma_rad)) {
+        initializeFromAlignment(*solution, "heading bank");
+        return;
+      }
     }
   }
   if (tryCourseInitialize(fix, p_ant)) return;
   if (!align_) recordBeforeInit(fix);  // else it waits in pending_
 }
 
-void GnssIns::setInitialCovariance(const GnssFix& fix, double heading_sigma_rad) {
-  P_.setZero();
-  P_.block<3, 3>(kInsP, kInsP).diagonal() << fix.sigma_h_m * fix.sigma_h_m,
+void GnssIns::startBank() {
+  const auto& anchor = std::get<ImuSample>(pending_.front());
+  const GnssFix& fix = std::get<GnssFix>(pending_.back());
+  InsState start;
+  start.R_enu_b = align_->anchorAttitude();
+  start.p_enu = enu_.toEnu({fix.lat_deg, fix.lon_deg, fix.h_ellipsoid_m}) -
+                Eigen::Vector3d(0.0, 0.0, (start.R_enu_b * config_.lever_arm_b).z());
+  start.ba_b_mps2 = align_->accBias();
+  start.bg_b_radps = align_->gyrBias();
+  start.time_offset_s = config_.receiver_time_offset_s;
+  bank_ = std::make_unique<HeadingBank>(config_, enu_, anchor, start,
+                                        initialCovariance(fix, start.R_enu_b, 0.0));
+  for (std::size_t k = 1; k < pending_.size(); ++k) {
+    if (const auto* s = std::get_if<ImuSample>(&pending_[k])) {
+      bank_->addImu(*s);
+    } else {
+      bank_->addFix(std::get<GnssFix>(pending_[k]));
+    }
+  }
+}
+
+InsMatrix GnssIns::initialCovariance(const GnssFix& fix, const Eigen::Matrix3d& R,
+                                     double heading_sigma_rad) const {
+  InsMatrix P = InsMatrix::Zero();
+  P.block<3, 3>(kInsP, kInsP).diagonal() << fix.sigma_h_m * fix.sigma_h_m,
       fix.sigma_h_m * fix.sigma_h_m, fix.sigma_v_m * fix.sigma_v_m;
-  P_.block<3, 3>(kInsV, kInsV).diagonal().setConstant(std::pow(config_.init_velocity_sigma_mps, 2));
+  P.block<3, 3>(kInsV, kInsV).diagonal().setConstant(std::pow(config_.init_velocity_sigma_mps, 2));
   // Tilt and heading sigmas are about ENU axes; the error angle is in the body (local) frame.
   const double tilt = config_.init_tilt_sigma_deg * kDegToRad;
   const Eigen::Vector3d att_var(tilt * tilt, tilt * tilt, heading_sigma_rad * heading_sigma_rad);
-  const Eigen::Matrix3d& R = x_.R_enu_b;
-  P_.block<3, 3>(kInsTheta, kInsTheta) = R.transpose() * att_var.asDiagonal() * R;
-  P_.block<3, 3>(kInsBa, kInsBa)
+  P.block<3, 3>(kInsTheta, kInsTheta) = R.transpose() * att_var.asDiagonal() * R;
+  P.block<3, 3>(kInsBa, kInsBa)
       .diagonal()
       .setConstant(std::pow(config_.init_acc_bias_sigma_mps2, 2));
-  P_.block<3, 3>(kInsBg, kInsBg)
+  P.block<3, 3>(kInsBg, kInsBg)
       .diagonal()
       .setConstant(std::pow(config_.init_gyr_bias_sigma_radps, 2));
-  P_(kInsTau, kInsTau) =
+  P(kInsTau, kInsTau) =
       config_.estimate_time_offset ? std::pow(config_.time_offset_sigma_s, 2) : 0.0;
+  return P;
 }
 
-void GnssIns::initializeFromAlignment(const AlignmentSolution& a) {
+void GnssIns::setInitialCovariance(const GnssFix& fix, double heading_sigma_rad) {
+  P_ = initialCovariance(fix, x_.R_enu_b, heading_sigma_rad);
+}
+
+void GnssIns::initializeFromAlignment(const AlignmentSolution& a, const std::string& method) {
   std::vector<Event> events;
   events.swap(pending_);
   align_.reset();
+  bank_.reset();
   // Events up to the anchor sample are before initialisation; the rest are replayed.
   std::size_t k = 0;
   for (; k < events.size(); ++k) {
@@ -124,12 +170,12 @@ void GnssIns::initializeFromAlignment(const AlignmentSolution& a) {
   initialized_ = true;
   stats_.t_init_ns = a.anchor.t_ns;
   stats_.t_heading_ns = last_imu_->t_ns;
-  stats_.init_method = "track";
+  stats_.init_method = method;
   stats_.init_heading_sigma_deg = a.heading_sigma_rad / kDegToRad;
   stats_.init_quiet_start = a.quiet_start;
   stats_.align_mount_yaw_deg = a.mount_yaw_rad / kDegToRad;
   stats_.align_mount_yaw_sigma_deg = a.mount_yaw_sigma_rad / kDegToRad;
-  if (estimate_mount_) {
+  if (estimate_mount_ && method == "track") {
     // The turns' mount yaw until the direction of travel refines it (updateMount).
     R_v_b_ = Eigen::AngleAxisd(a.mount_yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
              R_v_b_config_;
@@ -176,6 +222,7 @@ bool GnssIns::tryCourseInitialize(const GnssFix& fix, const Eigen::Vector3d& p_a
   if (!pending_.empty() && std::holds_alternative<GnssFix>(pending_.back())) pending_.pop_back();
   flushPendingBeforeInit();
   align_.reset();
+  bank_.reset();
   // Coarse levelling (Groves section 5.6.2) from the mean specific force f = R^T (a - g), with the
   // acceleration a over the window taken from the GNSS velocities: up_b = normalise(f - R^T a),
   // iterated because R itself depends on the tilt.

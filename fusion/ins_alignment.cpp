@@ -271,4 +271,27 @@ std::optional<AlignmentSolution> TrackAlignment::solve() const {
   return out;
 }
 
+std::optional<AlignmentSolution> TrackAlignment::solutionWithHeading(double psi,
+                                                                     double sigma) const {
+  const Chunk& front = chunks_.front();
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(psi, Eigen::Vector3d::UnitZ()).toRotationMatrix() * front.R0;
+  AlignmentSolution out;
+  out.anchor = front.start;
+  out.R_enu_b = R;
+  if (const std::optional<ChunkHeading> h = chunkHeading(front)) {
+    out.p_en = h->p - (R * lever_b_).head<2>();
+    out.v_en = Eigen::Rotation2Dd(yawOf(front.R0)) * h->c;
+  } else if (front.fixes > 0) {
+    out.p_en = front.g.head<2>() / front.N(0, 0) - (R * lever_b_).head<2>();
+  } else {
+    return std::nullopt;
+  }
+  out.ba_b_mps2 = st_.ba_b_mps2;
+  out.bg_b_radps = bg_;
+  out.heading_sigma_rad = sigma;
+  out.quiet_start = quiet_;
+  return out;
+}
+
 }  // namespace gvio::fusion

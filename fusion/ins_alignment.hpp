@@ -45,6 +45,13 @@ struct AlignmentConfig {
   double quiet_gyro_mean_radps = 0.05;  // (and is not a steady turn)
   double quiet_acc_mps2 = 0.15;         // a quiet run ends at this change of the specific force
   double min_speed_mps = 0.3;           // slower chunks say nothing about the heading
+  // The heading bank (fusion/ins_heading_bank.hpp), consulted while the sums above say nothing:
+  // scouts over this many headings (0: none), chosen once the best leads every scout that
+  // converged more than same_solution_deg away by min_nll_gap in -2 log-likelihood.
+  int hypotheses = 12;
+  double same_solution_deg = 15.0;
+  double min_nll_gap = 30.0;
+  double bank_max_heading_sigma_deg = 15.0;  // the winner's own 1-sigma (the filter refines it)
 };
 
 struct AlignmentSolution {
@@ -80,6 +87,16 @@ class TrackAlignment {
   void addFix(std::int64_t t_ns, const Eigen::Vector3d& p_ant_enu, double sigma_h_m);
   // The heading solution once it is determined well enough, else nullopt.
   [[nodiscard]] std::optional<AlignmentSolution> solve() const;
+  // The start state for a heading found elsewhere (fusion/ins_heading_bank.hpp): psi the yaw of
+  // the levelled frame in ENU. Nullopt before the first fix.
+  [[nodiscard]] std::optional<AlignmentSolution> solutionWithHeading(double psi_rad,
+                                                                     double sigma_rad) const;
+  [[nodiscard]] const ImuSample& anchorSample() const { return chunks_.front().start; }
+  [[nodiscard]] const Eigen::Matrix3d& anchorAttitude() const { return chunks_.front().R0; }
+  [[nodiscard]] const Eigen::Matrix3d& attitudeNow() const { return st_.R_enu_b; }  // R_w'_b
+  [[nodiscard]] const Eigen::Vector3d& accBias() const { return st_.ba_b_mps2; }
+  [[nodiscard]] const Eigen::Vector3d& gyrBias() const { return bg_; }
+  [[nodiscard]] bool quietStart() const { return quiet_; }
 
  private:
   struct Chunk {

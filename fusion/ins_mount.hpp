@@ -13,9 +13,9 @@
 namespace gvio::fusion {
 
 struct MountConfig {
-  double min_speed_mps = 0.5;       // slower epochs say little about the direction
-  int min_samples = 30;             // epochs before an estimate is given
-  double min_concentration = 0.95;  // share of the scatter along the principal axis
+  double min_speed_mps = 0.5;      // slower epochs say little about the direction
+  int min_samples = 30;            // epochs before an estimate is given
+  double min_concentration = 0.9;  // share of the scatter along the principal axis
 };
 
 struct MountEstimate {

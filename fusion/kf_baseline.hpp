@@ -14,6 +14,10 @@ struct KfConfig {
   double q_velocity = 0.01;  // m^2/s^3: white noise density on the velocity error rate
   double initial_position_sigma_m = 10.0;
   double initial_velocity_sigma_mps = 1.0;
+  // Scale optimistic stated sigmas by what the innovations show, per fix quality, before gating
+  // (fusion/online_sigma_scale.hpp): the same screening the graph's smoother applies after the
+  // drive, done causally.
+  bool learn_noise = true;
   void validate() const;  // throws InvalidInput naming the field
 };
 

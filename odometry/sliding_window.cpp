@@ -279,7 +279,8 @@ SolveStats SlidingWindow::solve(bool use_imu) {
   ceres::Solve(options, &problem, &summary);
   stats.iterations = static_cast<int>(summary.iterations.size());
   stats.converged = summary.termination_type == ceres::CONVERGENCE;
-  if (with_time_offset && !stats.time_offset_held) recordFreeTimeOffset();
+  stats.time_offset_free = with_time_offset && !stats.time_offset_held;
+  if (stats.time_offset_free) recordFreeTimeOffset();
   return stats;
 }
 

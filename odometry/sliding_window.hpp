@@ -60,6 +60,7 @@ struct SolveStats {
   int iterations = 0;
   bool converged = false;
   bool time_offset_held = false;  // t_d estimated but held: the window's motion cannot observe it
+  bool time_offset_free = false;  // t_d estimated and free in this solve
 };
 
 // How far the window's motion is from stationary (constant body-frame angular rate and specific

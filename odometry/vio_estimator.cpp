@@ -210,6 +210,7 @@ FrameResult VioEstimator::Impl::process(std::int64_t t_ns, const TrackedFrame& t
 
   const SolveStats stats = window.solve(imuActive());
   if (stats.time_offset_held) ++counters.time_offset_held_solves;
+  if (stats.time_offset_free) ++counters.time_offset_free_solves;
   window.landmarks().rejectOutliers(window.poseLookup(), geometry, window.timeOffsetS(),
                                     config.max_reprojection_px, config.min_depth_m,
                                     config.max_depth_m);

@@ -65,6 +65,7 @@ struct VioCounters {
   int imu_gaps = 0;
   // Solves of the time offset that held it: the window's motion too steady to observe it.
   int time_offset_held_solves = 0;
+  int time_offset_free_solves = 0;  // ... and those that estimated it
   // Frames whose exposure change the tracker removed (TrackerConfig::gain_threshold): against the
   // previous left image, and between the left and the right image.
   int exposure_corrected_frames = 0;

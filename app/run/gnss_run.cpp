@@ -193,6 +193,7 @@ nlohmann::json gnssReport(const GnssRunResult& r, std::size_t fixes_in_dataset) 
           {"ms_smoothing", r.stats.ms_smoothing},
           {"smoother_outliers", r.stats.smoother_outliers},
           {"smoother_sigma_scale", sigmaScaleJson(r.stats.smoother_sigma_scale)},
+          {"kf_sigma_scale", sigmaScaleJson(r.stats.kf_sigma_scale)},
           {"position_sigma_m", positionSigma(r.fused_covariance)},
           {"poses_before_registration", r.stats.poses_before_alignment},
           {"ms_per_fix", {{"mean", cost.mean}, {"p95", cost.p95}, {"max", cost.max}}},

@@ -256,7 +256,7 @@ json gnssInsReport(const io::Dataset& ds, const InsRunResult& r, const InsReport
       {"heading_sigma_deg", s.t_init_ns ? json(s.init_heading_sigma_deg) : json(nullptr)},
       {"gyro_bias_from_rest", s.init_quiet_start},
       {"alignment_restarts", s.alignment_restarts}};
-  if (s.init_method == "track") {
+  if (s.init_method == "track") {  // the heading bank leaves the mount to the direction of travel
     report["gnss"]["initialisation"]["mount_yaw_from_turns_deg"] = s.align_mount_yaw_deg;
     report["gnss"]["initialisation"]["mount_yaw_from_turns_sigma_deg"] =
         s.align_mount_yaw_sigma_deg;

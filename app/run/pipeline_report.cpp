@@ -9,6 +9,7 @@
 #include "run/pipeline_stages.hpp"
 #include "run/report.hpp"
 #include "run/stats.hpp"
+#include "run/time_offset_summary.hpp"
 
 namespace gvio::run {
 namespace {
@@ -84,10 +85,12 @@ void logSummary(const RunState& s, const Evaluations& e) {
                  s.gnss->screening.skipped(), g.outages.size(), smoother, fused_ape);
   }
   const TimingSummary total = summarizeTimings(s.vio.timings.total_ms);
+  std::string time_offset = timeOffsetText(vioTimeOffset(s.vio));
+  if (!time_offset.empty()) time_offset = ", " + time_offset;
   spdlog::info(
-      "{} frames, {} keyframes, {} poses written, {}, {:.1f} ms/frame (p95 {:.1f}){}; wrote {}",
+      "{} frames, {} keyframes, {} poses written, {}, {:.1f} ms/frame (p95 {:.1f}){}{}; wrote {}",
       s.vio.counters.frames, s.vio.counters.keyframes, s.vio.trajectory.size(), ape, total.mean,
-      total.p95, partialNote(vioCoverage(s.dataset, s.vio)), s.request.out.string());
+      total.p95, time_offset, partialNote(vioCoverage(s.dataset, s.vio)), s.request.out.string());
 }
 
 }  // namespace

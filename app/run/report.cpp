@@ -1,10 +1,13 @@
 #include "run/report.hpp"
 
+#include "run/time_offset_summary.hpp"
+
 #include <algorithm>
 
 #include "io/dataset_summary.hpp"
 #include "run/coverage.hpp"
 #include "run/stats.hpp"
+#include "run/time_offset_summary.hpp"
 
 namespace gvio::run {
 namespace {
@@ -38,12 +41,14 @@ json evaluationJson(const EvaluationOutcome& outcome) {
 json timeOffsetJson(const io::Dataset& ds, const VioRunResult& run) {
   json history = json::array();
   for (const auto& [t_ns, t_d] : run.time_offset_history) history.push_back({seconds(t_ns), t_d});
-  return {{"estimated", run.time_offset_estimated},
-          {"calibration_timeshift_cam_imu_s", ds.camera_timeshift_s},
-          {"t_d_s", run.time_offset_s},
-          {"stamp_lag_s", run.time_offset_s - ds.camera_timeshift_s},
-          {"held_solves", run.counters.time_offset_held_solves},
-          {"history", history}};
+  json j = {{"estimated", run.time_offset_estimated},
+            {"calibration_timeshift_cam_imu_s", ds.camera_timeshift_s},
+            {"t_d_s", run.time_offset_s},
+            {"stamp_lag_s", run.time_offset_s - ds.camera_timeshift_s},
+            {"held_solves", run.counters.time_offset_held_solves},
+            {"history", history}};
+  j.update(timeOffsetSummaryJson(vioTimeOffset(run)));
+  return j;
 }
 
 }  // namespace

@@ -216,7 +216,11 @@ VioRunResult runVio(const io::Dataset& ds, odometry::EstimatorConfig config,
         next = FrameStepper::Next{ds.frames[index + 1].t_ns, &peeked->images};
     }
     const odometry::RectifiedImages& images = loaded->images;
+    const int free_before = estimator.counters().time_offset_free_solves;
     const odometry::FrameResult result = stepper.step(frame.t_ns, images, next ? &*next : nullptr);
+    if (estimator.counters().time_offset_free_solves > free_before) {
+      r.time_offset_free_estimates.push_back(estimator.timeOffsetS());
+    }
     r.timings.load_ms.push_back(loaded->load_ms);
     r.timings.rectify_ms.push_back(loaded->rectify_ms);
     r.timings.tracking_ms.push_back(result.ms_tracking);

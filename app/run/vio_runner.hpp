@@ -46,6 +46,7 @@ struct VioRunResult {
   bool time_offset_estimated = false;
   double time_offset_s = 0.0;
   std::vector<std::pair<std::int64_t, double>> time_offset_history;
+  std::vector<double> time_offset_free_estimates;  // t_d after each free solve, in order
   FrameTimings timings;
   double wall_s = 0.0;
   bool stopped = false;  // VioRunOptions::stop ended the run before the last frame

@@ -62,6 +62,7 @@ TEST(CliTimeOffset, KalibrTimeshiftUndoesALaggingCameraAndTheEstimateIsReported)
   EXPECT_DOUBLE_EQ(shifted["time_offset"]["calibration_timeshift_cam_imu_s"].get<double>(), -0.02);
   EXPECT_FALSE(ignored["time_offset"]["estimated"].get<bool>());
   EXPECT_EQ(ignored["time_offset"]["t_d_s"].get<double>(), 0.0);
+  EXPECT_EQ(ignored["time_offset"]["status"], "not estimated");
 
   const auto& t = estimated["time_offset"];
   EXPECT_TRUE(t["estimated"].get<bool>());
@@ -89,6 +90,9 @@ TEST(CliTimeOffset, KalibrTimeshiftUndoesALaggingCameraAndTheEstimateIsReported)
   // turns only from 9.8 s on.
   EXPECT_NEAR(t["t_d_s"].get<double>(), 0.02, 0.001);
   EXPECT_GE(sync["time_offset"]["held_solves"].get<int>(), 50);
+  // Observed in the turn: an estimate with the spread of its late free solves.
+  EXPECT_EQ(t["status"], "estimated");
+  EXPECT_LT(t["sigma_s"].get<double>(), 0.005);
 }
 
 // The hold keeps the median of the latest free solves' t_d, not the last one's. With a 15 px KLT
@@ -110,6 +114,24 @@ TEST(CliTimeOffset, AHoldKeepsTheMedianOfTheLastFreeSolvesNotAnOutlier) {
   const auto report = nlohmann::json::parse(test::readText(dir.path() / "out" / "report.json"));
   EXPECT_GE(report["time_offset"]["held_solves"].get<int>(), 50);
   EXPECT_LT(std::abs(report["time_offset"]["t_d_s"].get<double>()), 0.003);
+}
+
+// The demo drive's first 9 s are straight at a constant 8 m/s: the offset is held in nearly every
+// solve, and the run says "not observed" instead of printing the prior's value as an estimate.
+TEST(CliTimeOffset, AStraightSteadyDriveSaysNotObserved) {
+  const fs::path straight = test::cachedSimulation(
+      fmt::format("--trajectory {}/assets/demo/drive.tum --seconds 9 --seed 6 --format euroc",
+                  GVIO_SOURCE_DIR));
+  test::TempDir dir("cli_time_offset_straight");
+  const test::CommandResult r = test::runGvio(fmt::format(
+      "run --dataset {} --out {} --no-progress --gnss off --set map.enabled=false --set "
+      "loops.enabled=false",
+      test::quoted(straight), test::quoted(dir.path() / "out")));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(test::readText(dir.path() / "out" / "report.json"));
+  EXPECT_EQ(report["time_offset"]["status"], "not observed") << report["time_offset"].dump();
+  EXPECT_TRUE(report["time_offset"]["sigma_s"].is_null());
+  EXPECT_NE(r.err.find("camera-IMU time offset not observed"), std::string::npos) << r.err;
 }
 
 // A slalom (6 m/s, +-1 m at 0.4 Hz, yaw rate up to 1 rad/s) excites the time offset from the
@@ -161,6 +183,8 @@ TEST(CliTimeOffset, AnExcitedDriveEstimatesTheLagAndRecoversTheTrajectory) {
   }
   EXPECT_LE(off_by_over_1ms, 1);
   EXPECT_EQ(on["time_offset"]["held_solves"].get<int>(), 0);  // excited all the way
+  EXPECT_EQ(on["time_offset"]["status"], "estimated");
+  EXPECT_LT(on["time_offset"]["sigma_s"].get<double>(), 0.002);
 }
 
 }  // namespace

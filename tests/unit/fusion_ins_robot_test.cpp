@@ -160,8 +160,9 @@ InsConfig robotConfig(const ImuNoise& imu = ImuNoise{}) {
 
 // With the default IMU model (ImuNoise{}, the grade gvio simulate draws). Measured (seeds 1-3):
 // the trajectory covers the fixes' whole span from the anchor at 0.5 s, horizontal RMS 0.98 /
-// 0.85 / 1.15 m against the raw fixes' 1.64 / 1.55 / 1.71 m; heading known after 50 / 48 / 108 s
-// (sigma 5.0 / 4.7 / 5.0 deg); mount yaw 93.7 / 89.6 / 86.5 deg.
+// 0.85 / 1.17 m against the raw fixes' 1.64 / 1.55 / 1.71 m; heading from the alignment's sums
+// after 50 / 48 s (sigma 5.0 / 4.7 deg), from the heading bank after 56 s on seed 3 (9.3 deg);
+// mount yaw 93.7 / 89.6 / 95.0 deg.
 TEST(GnssInsRobot, SlowRobotWithATurnedImuIsCoveredFromItsStart) {
   for (unsigned seed = 1; seed <= 3; ++seed) {
     const Outcome o = drive(Robot(), robotConfig(), seed);
@@ -176,7 +177,7 @@ TEST(GnssInsRobot, SlowRobotWithATurnedImuIsCoveredFromItsStart) {
         static_cast<double>(*s.t_init_ns - kT0Ns) * 1e-9,
         static_cast<double>(*s.t_heading_ns - kT0Ns) * 1e-9, s.init_heading_sigma_deg, s.fixes_used,
         s.fixes_rejected, s.fixes_before_init, rpy_deg.x(), rpy_deg.y(), rpy_deg.z());
-    EXPECT_EQ(s.init_method, "track");
+    EXPECT_TRUE(s.init_method == "track" || s.init_method == "heading bank") << s.init_method;
     EXPECT_TRUE(s.init_quiet_start);
     EXPECT_GE(o.coverage, 0.95);
     EXPECT_LT(o.rmse_h, 0.7 * o.raw_rmse_h);
@@ -189,19 +190,35 @@ TEST(GnssInsRobot, SlowRobotWithATurnedImuIsCoveredFromItsStart) {
 
 // The same robot with its mount configured as zero and not estimated: the constraint then
 // fights the motion (a robot moving along its body y axis) and its mean innovation says so.
-// With a consumer-grade IMU (0.1 deg/s/sqrt(Hz) gyro) the residual gyro bias tilts the levelled
-// frame faster than the turns reveal the mount: the alignment does not claim a heading it cannot
-// support (measured: no initialisation on seeds 1-3, the window started again twice). What it
-// must never do is start with a wrong one.
-TEST(GnssInsRobot, ConsumerGradeImuClaimsNoWrongHeading) {
+// With a consumer-grade IMU (0.1 deg/s/sqrt(Hz) gyro, 0.02 m/s^2/sqrt(Hz) accelerometer) the
+// residual gyro bias tilts the levelled frame faster than the turns reveal the mount: the
+// alignment's sums find no heading (without the bank: no initialisation on seeds 1-3). The heading
+// bank's scouts estimate tilt and bias with the fixes; the best leads the others by far after
+// 60-90 s. Measured (seeds 1-3): heading at 86 / 59 / 62 s (sigma 10 deg), coverage 100 %,
+// horizontal RMS 1.15 / 0.95 / 1.21 m against the raw fixes' 1.64 / 1.55 / 1.71 m, mount yaw
+// 92.7 / 79.6 / 102.2 deg.
+TEST(GnssInsRobot, ConsumerGradeImuIsAlignedByTheHeadingBank) {
   for (unsigned seed = 1; seed <= 3; ++seed) {
     const Outcome o = drive(Robot(), robotConfig(consumerImu()), seed);
-    if (o.stats.t_init_ns) {
-      EXPECT_LT(o.rmse_h, o.raw_rmse_h) << "seed " << seed;
-    } else {
-      EXPECT_GE(o.stats.fixes_before_init, 700) << "seed " << seed;  // all kept, as such
-    }
+    ASSERT_TRUE(o.stats.t_init_ns.has_value()) << "seed " << seed;
+    std::printf(
+        "consumer seed %u: %s, heading at %.1f s (%.1f deg), coverage %.3f, rmse_h %.2f m "
+        "(raw %.2f)\n",
+        seed, o.stats.init_method.c_str(), (*o.stats.t_heading_ns - kT0Ns) * 1e-9,
+        o.stats.init_heading_sigma_deg, o.coverage, o.rmse_h, o.raw_rmse_h);
+    EXPECT_EQ(o.stats.init_method, "heading bank");
+    EXPECT_GE(o.coverage, 0.95);
+    EXPECT_LT(o.rmse_h, 0.85 * o.raw_rmse_h);
+    ASSERT_TRUE(o.stats.mount.has_value());
+    EXPECT_NEAR(o.stats.mount->rpy_rad.z(), 90.0 * kDeg, 20.0 * kDeg);
   }
+  // Without the bank the same drive never gets a heading; no fix is dropped for it, all are
+  // reported as before initialisation.
+  InsConfig no_bank = robotConfig(consumerImu());
+  no_bank.align.hypotheses = 0;
+  const Outcome o = drive(Robot(), no_bank, 1);
+  EXPECT_FALSE(o.stats.t_init_ns.has_value());
+  EXPECT_GE(o.stats.fixes_before_init, 700);
 }
 
 TEST(GnssInsRobot, AWrongMountShowsInTheConstraint) {
