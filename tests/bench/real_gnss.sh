@@ -18,6 +18,7 @@
 #   BENCH_WINDOWS="79.6:59.0" tests/bench/real_gnss.sh   # one window (start:length, s)
 #   BENCH_SET="fusion.smoother.bias_ratio=0.3" BENCH_OUT=out/bench/x tests/bench/real_gnss.sh
 #   BENCH_TABLE_ONLY=1 tests/bench/real_gnss.sh          # the table of what BENCH_OUT holds
+#   BENCH_FUSIONS=kf tests/bench/real_gnss.sh            # run the KF again, keep the graph's
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 BUILD_DIR="${BUILD_DIR:-build}"
@@ -26,6 +27,7 @@ DATA="${GVIO_SHARED_DATA:-../shared/data}/nagoya2023"
 CACHE_ROOT="${GVIO_BENCH_CACHE:-$BUILD_DIR/bench_cache}"
 OUT="${BENCH_OUT:-out/bench/real_gnss}"
 SOLUTIONS="${BENCH_SOLUTIONS:-spp rtk}"
+FUSIONS="${BENCH_FUSIONS:-graph kf}"  # e.g. BENCH_FUSIONS=kf: run only the KF (the rest kept)
 RUN_SET=()
 for kv in ${BENCH_SET:-}; do RUN_SET+=(--set "$kv"); done
 
@@ -73,7 +75,7 @@ if [ -z "${BENCH_TABLE_ONLY:-}" ]; then
         --errors-csv "$cell/$sol.fixes.errors.csv" > "$cell/$sol.fixes.eval.log" 2>&1 || true
       gnss_file=()
       [ "$sol" = spp ] || gnss_file=(--gnss-file "${SOLUTION_FILE[$sol]}")
-      for fusion in graph kf; do
+      for fusion in $FUSIONS; do
         run="$cell/$sol.$fusion"
         rm -rf "$run"
         echo "bench: $name: $sol $fusion" >&2
