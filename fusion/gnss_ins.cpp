@@ -107,7 +107,9 @@ GnssIns::GnssIns(GnssIns&&) noexcept = default;
 GnssIns& GnssIns::operator=(GnssIns&&) noexcept = default;
 GnssIns::~GnssIns() = default;
 
-void GnssIns::startAt(const ImuSample& anchor, const InsState& x, const InsMatrix& P) {
+void GnssIns::startAt(const ImuSample& anchor, const InsState& x, const InsMatrix& P,
+                      bool record_poses) {
+  record_poses_ = record_poses;
   x_ = x;
   P_ = P;
   last_imu_ = anchor;
@@ -123,6 +125,7 @@ double GnssIns::stampMinusFilter(std::int64_t t_ns) const {
 }
 
 void GnssIns::recordPose() {
+  if (!record_poses_) return;
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = x_.R_enu_b;
   T.translation() = x_.p_enu;

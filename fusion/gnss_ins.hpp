@@ -141,8 +141,10 @@ class GnssIns {
   // Closes the last outage at the last IMU sample.
   void finish();
   // Starts the filter at `anchor` with this state and covariance instead of initialising it
-  // (the heading bank's scouts, fusion/ins_heading_bank.hpp).
-  void startAt(const ImuSample& anchor, const InsState& x, const InsMatrix& P);
+  // (the heading bank's scouts, fusion/ins_heading_bank.hpp, which keep no trajectory: twelve of
+  // them at 200 Hz would hold 40 MB a minute).
+  void startAt(const ImuSample& anchor, const InsState& x, const InsMatrix& P,
+               bool record_poses = true);
 
   [[nodiscard]] bool initialized() const { return initialized_; }
   [[nodiscard]] const InsState& state() const { return x_; }
@@ -191,6 +193,7 @@ class GnssIns {
   Eigen::Matrix3d R_v_b_config_ = Eigen::Matrix3d::Identity();  // from mount_rpy_deg
   Eigen::Matrix3d R_v_b_ = Eigen::Matrix3d::Identity();         // in use (estimated or config)
   bool estimate_mount_ = false;
+  bool record_poses_ = true;
   bool mount_known_ = false;  // the constraint may be applied
   MountEstimator mount_estimator_;
   std::optional<TrackAlignment> align_;

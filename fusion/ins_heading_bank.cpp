@@ -42,7 +42,7 @@ HeadingBank::HeadingBank(const InsConfig& config, const EnuFrame& enu, const Imu
     const Eigen::Vector3d up_b = Rt.col(2);
     Pk.block<3, 3>(kInsTheta, kInsTheta) += sigma * sigma * up_b * up_b.transpose();
     scouts_.emplace_back(scout, enu);
-    scouts_.back().startAt(anchor, x, Pk);
+    scouts_.back().startAt(anchor, x, Pk, false);
   }
 }
 
