@@ -23,12 +23,16 @@ TEST(OnlineSigmaScale, LearnsTheRatioOfTheSpreadToTheStatedSigmas) {
   for (int i = 0; i < 300; ++i) {
     // Innovations 3x (horizontal) and 2x (vertical) what the stated sigmas say; RTK fixed ones as
     // stated.
+    // Drawn one by one: a call's argument order is the compiler's choice.
     const auto z2 = [&](double k) { return std::pow(k * n01(rng), 2); };
-    s.add(1, {z2(3.0), z2(3.0)}, z2(2.0));
-    s.add(4, {z2(1.0), z2(1.0)}, z2(1.0));
+    const double e1 = z2(3.0), n1 = z2(3.0), u1 = z2(2.0);
+    s.add(1, {e1, n1}, u1);
+    const double e4 = z2(1.0), n4 = z2(1.0), u4 = z2(1.0);
+    s.add(4, {e4, n4}, u4);
   }
-  EXPECT_NEAR(s.scale(1).x(), 3.0, 0.4);
-  EXPECT_NEAR(s.scale(1).y(), 2.0, 0.4);
+  // The median of the last 200 (horizontal) / 100 (vertical) values: about 8 % / 11 % (1 sigma).
+  EXPECT_NEAR(s.scale(1).x(), 3.0, 0.6);
+  EXPECT_NEAR(s.scale(1).y(), 2.0, 0.6);
   EXPECT_EQ(s.scale(4).x(), std::max(1.0, s.scale(4).x()));  // never below the stated sigmas
   EXPECT_LT(s.scale(4).x(), 1.3);
   EXPECT_EQ(s.scales().size(), 2U);
