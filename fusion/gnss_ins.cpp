@@ -10,6 +10,7 @@
 
 #include "fusion/ins_heading_bank.hpp"
 #include "odometry/error.hpp"
+#include "odometry/lie.hpp"
 
 namespace gvio::fusion {
 namespace {
@@ -96,7 +97,7 @@ std::optional<Eigen::Vector2d> fixVelocityEn(const GnssFix& fix) {
 GnssIns::GnssIns(const InsConfig& config, const EnuFrame& enu)
     : config_(config), enu_(enu), mount_estimator_(config.mount) {
   config_.validate();
-  R_v_b_config_ = mountRotation(config_.mount_rpy_deg * kDegToRad);
+  R_v_b_config_ = odometry::rotationZyx(config_.mount_rpy_deg * kDegToRad);
   R_v_b_ = R_v_b_config_;
   estimate_mount_ = config_.estimate_mount && config_.mount_rpy_deg.isZero(0.0);
   mount_known_ = !estimate_mount_;

@@ -1,6 +1,5 @@
 #include "fusion/ins_error_model.hpp"
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
@@ -21,10 +20,7 @@ Eigen::Vector3d gravityEnu() {
 Eigen::Matrix3d rotationFromUpAndYaw(const Eigen::Vector3d& up_b, double yaw_rad) {
   const double pitch = std::asin(std::clamp(-up_b.x(), -1.0, 1.0));
   const double roll = std::atan2(up_b.y(), up_b.z());
-  return (Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
+  return odometry::rotationZyx({roll, pitch, yaw_rad});
 }
 
 InsState propagateNominal(const InsState& x, const Eigen::Vector3d& acc_b_mps2,

@@ -2,22 +2,11 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
-#include <algorithm>
 #include <cmath>
 
+#include "odometry/lie.hpp"
+
 namespace gvio::fusion {
-
-Eigen::Matrix3d mountRotation(const Eigen::Vector3d& rpy) {
-  return (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
-}
-
-Eigen::Vector3d mountRollPitchYaw(const Eigen::Matrix3d& R) {
-  return {std::atan2(R(2, 1), R(2, 2)), std::asin(std::clamp(-R(2, 0), -1.0, 1.0)),
-          std::atan2(R(1, 0), R(0, 0))};
-}
 
 void MountEstimator::add(const Eigen::Vector3d& v_b) {
   const double speed = v_b.norm();
@@ -41,7 +30,7 @@ std::optional<MountEstimate> MountEstimator::estimate(const Eigen::Matrix3d& R_v
   m.R_v_b =
       Eigen::Quaterniond::FromTwoVectors(forward, Eigen::Vector3d::UnitX()).toRotationMatrix() *
       R_v_b_config;
-  m.rpy_rad = mountRollPitchYaw(m.R_v_b);
+  m.rpy_rad = odometry::eulerZyx(m.R_v_b);
   m.samples = samples_;
   m.concentration = concentration;
   return m;

@@ -41,8 +41,4 @@ class MountEstimator {
   int samples_ = 0;
 };
 
-// R_v_b from roll, pitch and yaw (rad): Rz(yaw) Ry(pitch) Rx(roll), and back.
-Eigen::Matrix3d mountRotation(const Eigen::Vector3d& rpy_rad);
-Eigen::Vector3d mountRollPitchYaw(const Eigen::Matrix3d& R_v_b);
-
 }  // namespace gvio::fusion

@@ -1,7 +1,9 @@
 #include "odometry/lie.hpp"
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -130,6 +132,18 @@ Eigen::Matrix3d normalizeRotation(const Eigen::Matrix3d& M) {
   Eigen::Vector3d d = Eigen::Vector3d::Ones();
   d.z() = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
   return svd.matrixU() * d.asDiagonal() * svd.matrixV().transpose();
+}
+
+Eigen::Matrix3d rotationZyx(const Eigen::Vector3d& rpy) {
+  return (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+Eigen::Vector3d eulerZyx(const Eigen::Matrix3d& R) {
+  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  return {std::atan2(R(2, 1), R(2, 2)), pitch, std::atan2(R(1, 0), R(0, 0))};
 }
 
 }  // namespace gvio::odometry

@@ -31,4 +31,9 @@ Eigen::Matrix3d rightJacobianInverseSo3(const Eigen::Vector3d& phi);
 // drift of long products of rotation matrices.
 Eigen::Matrix3d normalizeRotation(const Eigen::Matrix3d& M);
 
+// ZYX Euler angles (roll, pitch, yaw; radians): R = Rz(yaw) Ry(pitch) Rx(roll), and back (pitch
+// within +-90 deg).
+Eigen::Matrix3d rotationZyx(const Eigen::Vector3d& rpy);
+Eigen::Vector3d eulerZyx(const Eigen::Matrix3d& R);
+
 }  // namespace gvio::odometry

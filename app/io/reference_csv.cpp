@@ -13,6 +13,7 @@
 #include "io/input_error.hpp"
 #include "io/text.hpp"
 #include "odometry/error.hpp"
+#include "odometry/lie.hpp"
 
 namespace gvio::io {
 namespace {
@@ -148,10 +149,7 @@ Trajectory referenceBodyPoses(const ReferenceCsv& reference, const fusion::EnuFr
   Trajectory out;
   for (const ReferenceEpoch& e : reference.epochs) {
     const Eigen::Vector3d rph = *e.rph_deg * kDegToRad;
-    const Eigen::Matrix3d R_ned_frd = (Eigen::AngleAxisd(rph.z(), Eigen::Vector3d::UnitZ()) *
-                                       Eigen::AngleAxisd(rph.y(), Eigen::Vector3d::UnitY()) *
-                                       Eigen::AngleAxisd(rph.x(), Eigen::Vector3d::UnitX()))
-                                          .toRotationMatrix();
+    const Eigen::Matrix3d R_ned_frd = odometry::rotationZyx(rph);
     Eigen::Isometry3d T_enu_b = Eigen::Isometry3d::Identity();
     T_enu_b.linear() = R_enu_ned * R_ned_frd * R_frd_flu;
     T_enu_b.translation() = enu.toEnu(e.lla);

@@ -10,10 +10,13 @@
 #include <string>
 
 #include "odometry/error.hpp"
+#include "odometry/lie.hpp"
 
 namespace gvio::sim {
 namespace {
 
+using odometry::eulerZyx;
+using odometry::rotationZyx;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 constexpr double kNsPerS = 1e9;
@@ -40,19 +43,6 @@ SplineBasis basisAt(double t_s, double spacing_s, int segments) {
   out.db = {-r * r / 2.0, (3.0 * s2 - 4.0 * s) / 2.0, (-3.0 * s2 + 2.0 * s + 1.0) / 2.0, s2 / 2.0};
   out.ddb = {r, 3.0 * s - 2.0, 1.0 - 3.0 * s, s};
   return out;
-}
-
-// ZYX Euler angles (roll, pitch, yaw) of R = Rz(yaw) Ry(pitch) Rx(roll).
-Eigen::Vector3d eulerZyx(const Eigen::Matrix3d& R) {
-  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
-  return {std::atan2(R(2, 1), R(2, 2)), pitch, std::atan2(R(1, 0), R(0, 0))};
-}
-
-Eigen::Matrix3d rotationZyx(const Eigen::Vector3d& rpy) {
-  return (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
 }
 
 // Body angular rate from ZYX Euler rates: omega_b = E(roll, pitch) * (roll', pitch', yaw')

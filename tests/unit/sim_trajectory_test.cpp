@@ -11,6 +11,7 @@
 #include <string>
 
 #include "odometry/error.hpp"
+#include "odometry/lie.hpp"
 #include "sim/trajectory_fit.hpp"
 
 namespace gvio::sim {
@@ -19,10 +20,7 @@ namespace {
 constexpr double kDeg = 180.0 / std::numbers::pi;
 
 Eigen::Matrix3d rotationZyx(double roll, double pitch, double yaw) {
-  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
+  return odometry::rotationZyx({roll, pitch, yaw});
 }
 
 // A car-like drive: 20 m/s along x, a 30 m lateral weave, a gentle climb; yaw follows the heading,
