@@ -252,7 +252,6 @@ bool GnssFusion::Impl::fuseKf(const Pair& pair) {
     const Eigen::Vector3d both = stated(pair.fix) + stated(prev_fix);
     const Eigen::Vector3d z2 = (z.tail<3>() * dt_prev).cwiseAbs2().cwiseQuotient(both);
     kf_noise.add(pair.fix.quality, z2.head<2>(), z2.z());
-    stats.kf_sigma_scale = kf_noise.scales();
   }
   KfBaseline candidate = kf;
   const double nis = candidate.update(z, R);
@@ -326,6 +325,9 @@ void GnssFusion::finish() {
         {p.t_ns, p.p_enu, FixStatus::kUnaligned, p.fix.sigma_h_m, p.fix.sigma_v_m});
   }
   s.alignment_pairs.clear();
+  if (s.config.mode == FusionMode::kKf && s.config.kf.learn_noise) {
+    s.stats.kf_sigma_scale = s.kf_noise.scales();
+  }
   std::sort(s.stats.fixes.begin(), s.stats.fixes.end(),
             [](const FixOutcome& a, const FixOutcome& b) { return a.t_ns < b.t_ns; });
   if (s.last_accepted_ns && !s.vio.empty() &&

@@ -99,8 +99,7 @@ GnssIns::GnssIns(const InsConfig& config, const EnuFrame& enu)
   config_.validate();
   R_v_b_config_ = odometry::rotationZyx(config_.mount_rpy_deg * kDegToRad);
   R_v_b_ = R_v_b_config_;
-  estimate_mount_ = config_.estimate_mount && config_.mount_rpy_deg.isZero(0.0);
-  mount_known_ = !estimate_mount_;
+  mount_known_ = !config_.estimatesMount();
   x_.time_offset_s = config_.receiver_time_offset_s;
 }
 
@@ -175,7 +174,7 @@ void GnssIns::processFix(const GnssFix& fix, const Eigen::Vector3d& p_ant) {
   updatePosition(fix, p_ant);
   if (config_.use_velocity) updateVelocity(fix);
   if (config_.use_nhc && mount_known_) updateNonHolonomic();
-  if (estimate_mount_) updateMount();
+  if (config_.estimatesMount()) updateMount();
 }
 
 void GnssIns::updateMount() {

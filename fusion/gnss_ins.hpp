@@ -82,6 +82,8 @@ struct InsConfig {
   double max_imu_gap_s = 0.1;  // longer IMU periods are counted as gaps (still integrated)
 
   void validate() const;  // throws InvalidInput naming the key (fusion.ins.*)
+  // The mount is estimated: estimate_mount with mount_rpy_deg left at zero.
+  [[nodiscard]] bool estimatesMount() const { return estimate_mount && mount_rpy_deg.isZero(0.0); }
 };
 
 enum class InsFixStatus { kUsed, kRejected, kBeforeInit };
@@ -192,7 +194,6 @@ class GnssIns {
   EnuFrame enu_;
   Eigen::Matrix3d R_v_b_config_ = Eigen::Matrix3d::Identity();  // from mount_rpy_deg
   Eigen::Matrix3d R_v_b_ = Eigen::Matrix3d::Identity();         // in use (estimated or config)
-  bool estimate_mount_ = false;
   bool record_poses_ = true;
   bool mount_known_ = false;  // the constraint may be applied
   MountEstimator mount_estimator_;

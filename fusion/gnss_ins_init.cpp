@@ -175,7 +175,7 @@ void GnssIns::initializeFromAlignment(const AlignmentSolution& a, const std::str
   stats_.init_quiet_start = a.quiet_start;
   stats_.align_mount_yaw_deg = a.mount_yaw_rad / kDegToRad;
   stats_.align_mount_yaw_sigma_deg = a.mount_yaw_sigma_rad / kDegToRad;
-  if (estimate_mount_ && method == "track") {
+  if (config_.estimatesMount() && method == "track") {
     // The turns' mount yaw until the direction of travel refines it (updateMount).
     R_v_b_ = Eigen::AngleAxisd(a.mount_yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
              R_v_b_config_;

@@ -16,9 +16,8 @@ constexpr double kMinChunkSpanS = 2.0;
 constexpr double kMaxChunkSigmaRad = 0.5;
 constexpr double kOutlierSigmas = 3.0;
 constexpr std::int64_t kShortNs = 500'000'000;  // the quiet test's short window
-constexpr double kSteadySpeed = 0.2;
-constexpr int kMinSteadyChunks = 4;  // turn sums before the mount yaw is believed             //
-                                     // relative speed change of a steady chunk
+constexpr double kSteadySpeed = 0.2;            // relative speed change of a steady chunk
+constexpr int kMinSteadyChunks = 4;             // turn sums before the mount yaw is believed
 
 double seconds(std::int64_t dt_ns) {
   return static_cast<double>(dt_ns) * 1e-9;

@@ -270,8 +270,7 @@ json gnssInsReport(const io::Dataset& ds, const InsRunResult& r, const InsReport
     mount["epochs"] = s.mount->samples;
     mount["concentration"] = s.mount->concentration;
   } else {
-    const bool estimating = r.config.estimate_mount && cfg.isZero(0.0);
-    mount["source"] = estimating ? "not yet estimated" : "config";
+    mount["source"] = r.config.estimatesMount() ? "not yet estimated" : "config";
     mount["rpy_deg"] = {cfg.x(), cfg.y(), cfg.z()};
   }
   report["gnss"]["mount"] = std::move(mount);
