@@ -11,6 +11,7 @@
 #include "odometry/lie.hpp"
 #include "odometry/measurements.hpp"
 #include "odometry/trajectory.hpp"
+#include "support/ins_drive.hpp"
 
 namespace gvio::test {
 
@@ -83,15 +84,7 @@ inline GnssDrive makeGnssDrive(double outage_t0_s = -1, double outage_t1_s = -1,
       const double dn = n01(rng), de = n01(rng);
       p += Eigen::Vector3d(de, dn, 0.2).normalized() * size_m;
     }
-    const fusion::Lla lla = d.enu.toLla(p);
-    GnssFix f;
-    f.t_ns = t_ns;
-    f.lat_deg = lla.lat_deg;
-    f.lon_deg = lla.lon_deg;
-    f.h_ellipsoid_m = lla.h_ellipsoid_m;
-    f.sigma_h_m = 1.5;
-    f.sigma_v_m = 3.0;
-    d.fixes.push_back(f);
+    d.fixes.push_back(fixAt(d.enu, t_ns, p, 1.5, 3.0));
     d.outlier.push_back(bad);
   }
   return d;

@@ -13,6 +13,7 @@
 
 #include "fusion/gnss_ins.hpp"
 #include "fusion/ins_alignment.hpp"
+#include "support/ins_drive.hpp"
 
 namespace gvio::fusion {
 namespace {
@@ -47,21 +48,12 @@ struct Robot {
   }
 };
 
-// Body positions on a 1 ms grid (trapezoidal integration of the velocity).
+// Body positions on a 1 ms grid.
 std::vector<Eigen::Vector3d> positions(const Robot& r) {
-  const int n = static_cast<int>(r.duration_s * 1000.0) + 2;
-  std::vector<Eigen::Vector3d> p(n, Eigen::Vector3d::Zero());
-  for (int i = 1; i < n; ++i) {
-    p[i] = p[i - 1] + 0.0005 * (r.velocity((i - 1) * 1e-3) + r.velocity(i * 1e-3));
-  }
-  return p;
+  return test::positionsOnMsGrid(r.duration_s, [&r](double t) { return r.velocity(t); });
 }
 
-Eigen::Vector3d positionAt(const std::vector<Eigen::Vector3d>& grid, double t) {
-  const auto i = static_cast<std::size_t>(std::floor(t * 1000.0));
-  const double s = t * 1000.0 - static_cast<double>(i);
-  return (1.0 - s) * grid[i] + s * grid[std::min(i + 1, grid.size() - 1)];
-}
+using test::positionAt;
 
 ImuNoise consumerImu() {
   ImuNoise n;
@@ -114,15 +106,8 @@ Outcome drive(const Robot& r, const InsConfig& config, unsigned seed) {
       const Eigen::Vector3d white = noise3(1.0);
       p_ant += Eigen::Vector3d(bias.x() + sigma_h * white.x(), bias.y() + sigma_h * white.y(),
                                sigma_v * white.z());
-      GnssFix fix;
-      fix.t_ns = kT0Ns + static_cast<std::int64_t>(std::llround(ts * 1e9));
-      const Lla lla = enu.toLla(p_ant);
-      fix.lat_deg = lla.lat_deg;
-      fix.lon_deg = lla.lon_deg;
-      fix.h_ellipsoid_m = lla.h_ellipsoid_m;
-      fix.sigma_h_m = sigma_h;
-      fix.sigma_v_m = sigma_v;
-      ins.addFix(fix);
+      ins.addFix(test::fixAt(enu, kT0Ns + static_cast<std::int64_t>(std::llround(ts * 1e9)), p_ant,
+                             sigma_h, sigma_v));
       raw += (p_ant - positionAt(grid, ts)).head<2>().squaredNorm();
       ++n_raw;
       if (n_raw == 1) out.first_fix_s = ts;

@@ -13,6 +13,7 @@
 #include "fusion/gnss_ins.hpp"
 #include "odometry/error.hpp"
 #include "odometry/lie.hpp"
+#include "support/ins_drive.hpp"
 #include "support/numeric_jacobian.hpp"
 
 namespace gvio::fusion {
@@ -123,22 +124,13 @@ struct SimDrive {
     return speed(t) * Eigen::Vector3d(std::cos(yaw(t)), std::sin(yaw(t)), 0.0);
   }
 
-  // Body positions on a 1 ms grid (trapezoidal integration of the velocity).
+  // Body positions on a 1 ms grid.
   std::vector<Eigen::Vector3d> positions() const {
-    const int n = static_cast<int>(duration_s * 1000.0) + 2;
-    std::vector<Eigen::Vector3d> p(n, Eigen::Vector3d::Zero());
-    for (int i = 1; i < n; ++i) {
-      p[i] = p[i - 1] + 0.0005 * (velocity((i - 1) * 1e-3) + velocity(i * 1e-3));
-    }
-    return p;
+    return test::positionsOnMsGrid(duration_s, [this](double t) { return velocity(t); });
   }
 };
 
-Eigen::Vector3d positionAt(const std::vector<Eigen::Vector3d>& grid, double t) {
-  const auto i = static_cast<std::size_t>(std::floor(t * 1000.0));
-  const double s = t * 1000.0 - static_cast<double>(i);
-  return (1.0 - s) * grid[i] + s * grid[std::min(i + 1, grid.size() - 1)];
-}
+using test::positionAt;
 
 struct SimOutcome {
   double rmse_h = 0.0, rmse_3d = 0.0, raw_rmse_h = 0.0, max_err_in_outage = 0.0;
@@ -193,14 +185,8 @@ SimOutcome simulate(const SimSpec& spec, const InsConfig& config) {
       const Eigen::Vector3d w_b = d.R_vehicle_b.transpose() * Eigen::Vector3d(0, 0, d.yawRate(te));
       const Eigen::Vector3d v_ant = d.velocity(te) + R * w_b.cross(d.lever_b) +
                                     Eigen::Vector3d(n01(rng), n01(rng), 0.0) * 0.05;
-      GnssFix fix;
-      fix.t_ns = kT0Ns + static_cast<std::int64_t>(std::llround(ts * 1e9));
-      const Lla lla = enu.toLla(p_ant);
-      fix.lat_deg = lla.lat_deg;
-      fix.lon_deg = lla.lon_deg;
-      fix.h_ellipsoid_m = lla.h_ellipsoid_m;
-      fix.sigma_h_m = sigma_h;
-      fix.sigma_v_m = sigma_v;
+      GnssFix fix = test::fixAt(enu, kT0Ns + static_cast<std::int64_t>(std::llround(ts * 1e9)),
+                                p_ant, sigma_h, sigma_v);
       fix.speed_mps = v_ant.head<2>().norm();
       fix.course_deg = std::atan2(v_ant.x(), v_ant.y()) * 180.0 / M_PI;
       ins.addFix(fix);
