@@ -49,6 +49,10 @@ json statsJson(const eval::Stats& s) {
           {"max", s.max},   {"n", s.n}};
 }
 
+json optionalSeconds(const std::optional<std::int64_t>& t_ns) {
+  return t_ns ? json(seconds(*t_ns)) : json(nullptr);
+}
+
 json optionalStats(const std::optional<eval::Stats>& s) {
   return s ? statsJson(*s) : json(nullptr);
 }
@@ -230,7 +234,7 @@ json gnssInsReport(const io::Dataset& ds, const InsRunResult& r, const InsReport
       {"nhc_rejected", s.nhc_rejected},
       {"nhc_mean_innovation_mps", nhc ? json{nhc->x(), nhc->y()} : json(nullptr)},
       {"registered", s.t_init_ns.has_value()},
-      {"t_init", s.t_init_ns ? json(seconds(*s.t_init_ns)) : json(nullptr)},
+      {"t_init", optionalSeconds(s.t_init_ns)},
       {"ms_per_fix", {{"mean", cost.mean}, {"p95", cost.p95}, {"max", cost.max}}},
       {"lever_arm_b",
        {r.config.lever_arm_b.x(), r.config.lever_arm_b.y(), r.config.lever_arm_b.z()}},
@@ -246,9 +250,6 @@ json gnssInsReport(const io::Dataset& ds, const InsRunResult& r, const InsReport
         {"lon_deg", r.origin.lon_deg},
         {"h_ellipsoid_m", r.origin.h_ellipsoid_m}}}};
   if (!ctx.gnss_noise.is_null()) report["gnss"]["noise_added"] = ctx.gnss_noise;
-  const auto optionalSeconds = [](const std::optional<std::int64_t>& t) {
-    return t ? json(seconds(*t)) : json(nullptr);
-  };
   report["gnss"]["initialisation"] = {
       {"method", s.init_method.empty() ? json(nullptr) : json(s.init_method)},
       {"t_start", optionalSeconds(s.t_init_ns)},
