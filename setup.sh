@@ -26,6 +26,7 @@ PACKAGES=(
   libgeographiclib-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
   nlohmann-json3-dev libcairo2-dev zlib1g-dev
   librosbag-storage-dev libsensor-msgs-dev libroscpp-core-dev libbz2-dev
+  libzstd-dev liblz4-dev libsqlite3-dev
 )
 # Only the modes that build the test suite need its frameworks.
 TEST_PACKAGES=(libgtest-dev libgmock-dev libbenchmark-dev)

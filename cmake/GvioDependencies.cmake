@@ -22,6 +22,10 @@ find_package(PkgConfig REQUIRED)
 pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy)
 pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
 pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)
+# ROS 2 bags: MCAP chunks compressed with zstd or lz4 (frame format), sqlite3 storage (.db3).
+pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
+pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
+pkg_check_modules(SQLITE3 REQUIRED IMPORTED_TARGET sqlite3)
 
 # GeographicLib ships only a Find module on Debian (in /usr/share/cmake/geographiclib).
 list(APPEND CMAKE_MODULE_PATH /usr/share/cmake/geographiclib)

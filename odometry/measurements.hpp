@@ -41,7 +41,8 @@ struct GnssFix {
 // How a raw camera's lens bends rays away from the pinhole projection (x = X/Z, y = Y/Z, r = |x
 // y|).
 enum class Distortion {
-  // Radial-tangential (OpenCV plumb_bob, Kalibr radtan): coefficients k1 k2 p1 p2 [k3]. No
+  // Radial-tangential (OpenCV plumb_bob, Kalibr radtan): coefficients k1 k2 p1 p2 [k3], or with
+  // k4 k5 k6 the rational model (ROS rational_polynomial, OpenCV's 8 coefficients). No
   // coefficients, or all of them 0, is the undistorted pinhole camera.
   kRadtan,
   // Equidistant fisheye (Kannala & Brandt 2006, OpenCV cv::fisheye, Kalibr equidistant): the
@@ -64,7 +65,7 @@ struct CameraModel {
   double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
   // How `distortion` is read. Rectified cameras are radtan with no coefficients (a pinhole).
   Distortion distortion_model = Distortion::kRadtan;
-  std::vector<double> distortion;  // radtan: k1 k2 p1 p2 [k3]; equidistant: k1 k2 k3 k4
+  std::vector<double> distortion;  // radtan: k1 k2 p1 p2 [k3 [k4 k5 k6]]; equidistant: k1..k4
   Eigen::Isometry3d T_b_c = Eigen::Isometry3d::Identity();
 };
 

@@ -31,9 +31,10 @@ void validateCamera(const CameraModel& cam) {
                          "coefficients (k1 k2 k3 k4), got " +
                          std::to_string(n));
     }
-  } else if (n != 0 && n != 4 && n != 5) {
-    throw InvalidInput(nameOf(cam) + ": expected 0, 4 or 5 distortion coefficients (k1 k2 p1 p2 " +
-                       "[k3]), got " + std::to_string(n));
+  } else if (n != 0 && n != 4 && n != 5 && n != 8) {
+    // 8: OpenCV's rational model (ROS's rational_polynomial), which cv::undistort takes as is.
+    throw InvalidInput(nameOf(cam) + ": expected 0, 4, 5 or 8 distortion coefficients (k1 k2 p1 " +
+                       "p2 [k3 [k4 k5 k6]]), got " + std::to_string(n));
   }
   for (const double d : cam.distortion) {
     if (!std::isfinite(d)) throw InvalidInput(nameOf(cam) + ": distortion is not finite");

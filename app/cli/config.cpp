@@ -478,6 +478,8 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("sim.imu_noise_scale_max", c.sim.imu_noise_scale_max),
       number("sim.imu_turn_on_acc_bias_mps2", c.sim.imu_turn_on_acc_bias_mps2),
       number("sim.imu_turn_on_gyr_bias_radps", c.sim.imu_turn_on_gyr_bias_radps),
+      text("sim.ros2bag_storage", c.sim.ros2bag_storage),
+      text("sim.ros2bag_compression", c.sim.ros2bag_compression),
       integer("fleet.retries", c.fleet.retries),
       integer("fleet.slurm.cpus_per_task", c.fleet.slurm.cpus_per_task),
       integer("fleet.slurm.mem_mb", c.fleet.slurm.mem_mb),

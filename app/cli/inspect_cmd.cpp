@@ -66,11 +66,14 @@ int runInspect(const InspectOptions& opt, const CommonOptions& common) {
 Command addInspectCommand(CLI::App& app, const CommonOptions& common) {
   auto opt = std::make_shared<InspectOptions>();
   CLI::App* sub = app.add_subcommand("inspect", "Validate a dataset and summarise its sensors");
-  sub->add_option("--dataset", opt->dataset,
-                  "Dataset folder (KITTI raw drive, EuRoC, comma2k19), ROS1 bag or NMEA log")
+  sub->add_option(
+         "--dataset", opt->dataset,
+         "Dataset folder (KITTI raw drive, EuRoC, comma2k19), ROS 1 bag, ROS 2 bag (folder, .mcap, "
+         ".db3) or NMEA log")
       ->required();
   sub->add_option("--format", opt->format, "Dataset format")
-      ->check(CLI::IsMember({"auto", "kitti-raw", "euroc", "nmea", "comma2k19", "rosbag"}));
+      ->check(
+          CLI::IsMember({"auto", "kitti-raw", "euroc", "nmea", "comma2k19", "rosbag", "ros2bag"}));
   sub->add_option("--json", opt->json, "Also write the summary as JSON to this file");
   sub->add_option("--calib", opt->calib,
                   "Kalibr calibration replacing the dataset's (camchain.yaml and/or imu.yaml)");

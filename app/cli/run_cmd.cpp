@@ -67,12 +67,14 @@ Command addRunCommand(CLI::App& app, const CommonOptions& common) {
   auto opt = std::make_shared<RunOptions>();
   CLI::App* sub =
       app.add_subcommand("run", "Visual-inertial odometry over a dataset, written as a run folder");
-  sub->add_option("--dataset", opt->dataset,
-                  "Dataset folder (KITTI raw drive, EuRoC; comma2k19 CSV: IMU + GNSS without a "
-                  "camera runs GNSS/INS) or ROS1 bag (.bag, with --calib)")
+  sub->add_option(
+         "--dataset", opt->dataset,
+         "Dataset folder (KITTI raw drive, EuRoC; comma2k19 CSV: IMU + GNSS without a "
+         "camera runs GNSS/INS), ROS 1 bag (.bag, with --calib) or ROS 2 bag (folder, .mcap, "
+         ".db3; calibration from its CameraInfo and /tf_static, or --calib)")
       ->required();
   sub->add_option("--format", opt->format, "Dataset format")
-      ->check(CLI::IsMember({"auto", "kitti-raw", "euroc", "comma2k19", "rosbag"}))
+      ->check(CLI::IsMember({"auto", "kitti-raw", "euroc", "comma2k19", "rosbag", "ros2bag"}))
       ->capture_default_str();
   sub->add_option("--gnss", opt->gnss,
                   "GNSS fusion: auto (graph when the dataset has fixes), off, kf (the reference "

@@ -115,9 +115,11 @@ Command addSimulateCommand(CLI::App& app, const CommonOptions& common) {
                   "not the direction of travel; motion: a vehicle's, heading from the direction of "
                   "travel, pitch from the climb, roll zero");
   sub->add_option("--format", o->format,
-                  "Output layout: kitti-raw, euroc, or rosbag (drive.bag + Kalibr camchain.yaml "
-                  "and imu.yaml)")
-      ->check(CLI::IsMember({"kitti-raw", "euroc", "rosbag"}));
+                  "Output layout: kitti-raw, euroc, rosbag (drive.bag + Kalibr camchain.yaml "
+                  "and imu.yaml) or ros2bag (the folder is a ROS 2 bag: metadata.yaml + "
+                  "drive_0.mcap with CameraInfo and /tf_static; sim.ros2bag_storage sqlite3 for "
+                  "drive_0.db3)")
+      ->check(CLI::IsMember({"kitti-raw", "euroc", "rosbag", "ros2bag"}));
   sub->add_option("--seconds", o->request.seconds, "Simulate only the first S seconds");
   sub->add_option("--camera", o->camera, "stereo or mono")
       ->check(CLI::IsMember({"stereo", "mono"}));

@@ -11,6 +11,8 @@
 #include "io/input_error.hpp"
 #include "io/kitti_raw.hpp"
 #include "io/nmea.hpp"
+#include "io/ros2/ros2_bag.hpp"
+#include "io/ros2_dataset.hpp"
 #include "io/rosbag_dataset.hpp"
 
 namespace gvio::io {
@@ -53,6 +55,8 @@ std::string toString(DatasetFormat format) {
       return "comma2k19";
     case DatasetFormat::kRosbag:
       return "rosbag";
+    case DatasetFormat::kRos2Bag:
+      return "ros2bag";
   }
   return "unknown";
 }
@@ -64,8 +68,9 @@ std::optional<DatasetFormat> parseDatasetFormat(const std::string& name) {
   if (name == "nmea") return DatasetFormat::kNmea;
   if (name == "comma2k19") return DatasetFormat::kComma2k19;
   if (name == "rosbag") return DatasetFormat::kRosbag;
+  if (name == "ros2bag") return DatasetFormat::kRos2Bag;
   throw InvalidInput("unknown dataset format '" + name +
-                     "' (expected auto, kitti-raw, euroc, nmea, comma2k19 or rosbag)");
+                     "' (expected auto, kitti-raw, euroc, nmea, comma2k19, rosbag or ros2bag)");
 }
 
 DatasetFormat detectFormat(const fs::path& path) {
@@ -73,18 +78,23 @@ DatasetFormat detectFormat(const fs::path& path) {
   if (!fs::exists(path, ec)) throw InputError(path, 0, "dataset not found");
   if (fs::is_regular_file(path, ec)) {
     if (path.extension() == ".bag" || looksLikeRosbag(path)) return DatasetFormat::kRosbag;
+    if (path.extension() == ".mcap" || path.extension() == ".db3" || ros2::looksLikeRos2Bag(path)) {
+      return DatasetFormat::kRos2Bag;
+    }
     if (looksLikeNmeaFile(path)) return DatasetFormat::kNmea;
     throw InputError(path, 0,
-                     "a file that is neither a ROS bag nor an NMEA 0183 log (expected a dataset "
-                     "folder)");
+                     "a file that is neither a ROS bag (ROS 1 .bag, ROS 2 .mcap or .db3) nor an "
+                     "NMEA 0183 log (expected a dataset folder)");
   }
+  if (ros2::looksLikeRos2Bag(path)) return DatasetFormat::kRos2Bag;
   if (looksLikeKittiRaw(path)) return DatasetFormat::kKittiRaw;
   if (!findEurocMav0(path).empty()) return DatasetFormat::kEuroc;
   if (looksLikeComma2k19(path)) return DatasetFormat::kComma2k19;
   throw InputError(
       path, 0,
       "unrecognised dataset layout (expected a KITTI raw drive with oxts/ or image_00/, "
-      "an EuRoC folder with mav0/, or a comma2k19 folder with csv/imu.csv)");
+      "an EuRoC folder with mav0/, a comma2k19 folder with csv/imu.csv, or a ROS 2 bag folder "
+      "with metadata.yaml)");
 }
 
 Dataset readDataset(const fs::path& path, std::optional<DatasetFormat> format,
@@ -107,6 +117,9 @@ Dataset readDataset(const fs::path& path, std::optional<DatasetFormat> format,
       break;
     case DatasetFormat::kRosbag:
       ds = readRosbag(path, config);
+      break;
+    case DatasetFormat::kRos2Bag:
+      ds = readRos2Bag(path, config);
       break;
   }
   if (ds.frames.empty() && ds.imu.empty() && ds.gnss.empty()) {

@@ -17,7 +17,7 @@
 
 namespace gvio::io {
 
-enum class DatasetFormat { kKittiRaw, kEuroc, kNmea, kComma2k19, kRosbag };
+enum class DatasetFormat { kKittiRaw, kEuroc, kNmea, kComma2k19, kRosbag, kRos2Bag };
 std::string toString(DatasetFormat format);
 
 // One camera trigger: the timestamp and one image path per camera (same order as cameras); no
@@ -51,6 +51,13 @@ struct BagTopicUse {
   std::size_t zero_stamps = 0;       // header stamp 0: the bag's receive time stood in
 };
 
+// Where one calibration value came from (gvio inspect prints them): e.g. {"cam0 intrinsics",
+// "/cam0/camera_info (plumb_bob)"}, {"T_b_cam1", "/tf_static: imu_link -> cam1_optical"}.
+struct CalibrationSource {
+  std::string value;
+  std::string source;
+};
+
 struct Dataset {
   DatasetFormat format = DatasetFormat::kKittiRaw;
   std::filesystem::path root;
@@ -71,6 +78,12 @@ struct Dataset {
   double camera_timeshift_s = 0.0;
   std::shared_ptr<const ImageStore> image_store;  // set when frames carry no image paths
   std::vector<BagTopicUse> bag_topics;            // ROS bags only
+  std::vector<CalibrationSource> calibration_sources;
+  // Why a recording that can carry calibration (a ROS 2 bag) did not calibrate its cameras.
+  std::string calibration_missing;
+  // The GNSS antenna in the body (IMU) frame when the recording states it (a ROS 2 bag's
+  // /tf_static link to the NavSatFix frame); fusion.lever_arm_b, when set, overrides it.
+  std::optional<Eigen::Vector3d> gnss_lever_arm_b;
 };
 
 // The calibrated image size of each camera against its first image, before any frame is
@@ -99,8 +112,8 @@ Dataset readDataset(const std::filesystem::path& path, std::optional<DatasetForm
 // Format detection from the folder layout; throws InputError when nothing matches.
 DatasetFormat detectFormat(const std::filesystem::path& path);
 
-// Parses "auto" (nullopt), "kitti-raw", "euroc", "nmea", "comma2k19", "rosbag"; throws InvalidInput
-// otherwise.
+// Parses "auto" (nullopt), "kitti-raw", "euroc", "nmea", "comma2k19", "rosbag", "ros2bag"; throws
+// InvalidInput otherwise.
 std::optional<DatasetFormat> parseDatasetFormat(const std::string& name);
 
 }  // namespace gvio::io

@@ -168,6 +168,17 @@ json summarizeDataset(const Dataset& ds, double gap_factor, const ImuNoise& nois
   j["t_last"] = formatSeconds(t1);
   j["duration_s"] = seconds(t1 - t0);
   if (!ds.bag_topics.empty()) j["bag_topics"] = bagTopicsJson(ds);
+  if (!ds.calibration_sources.empty()) {
+    json sources = json::array();
+    for (const CalibrationSource& c : ds.calibration_sources) {
+      sources.push_back({{"value", c.value}, {"source", c.source}});
+    }
+    j["calibration_sources"] = sources;
+  }
+  if (ds.gnss_lever_arm_b) {
+    j["gnss_lever_arm_b_m"] = {ds.gnss_lever_arm_b->x(), ds.gnss_lever_arm_b->y(),
+                               ds.gnss_lever_arm_b->z()};
+  }
   j["warnings"] = ds.warnings;
   return j;
 }
@@ -250,6 +261,15 @@ std::string formatSummary(const json& j) {
                        t["type"].get<std::string>(), t["messages"].get<std::size_t>(),
                        t["used"].get<std::size_t>(), t["out_of_order_sorted"].get<std::size_t>(),
                        t["repeated_stamps_dropped"].get<std::size_t>());
+  }
+  for (const auto& c : j.value("calibration_sources", json::array())) {
+    out += fmt::format("calib     {:<16} from {}\n", c["value"].get<std::string>(),
+                       c["source"].get<std::string>());
+  }
+  if (j.contains("gnss_lever_arm_b_m")) {
+    const json& l = j["gnss_lever_arm_b_m"];
+    out += fmt::format("  GNSS antenna in the body frame [{:.3f} {:.3f} {:.3f}] m\n",
+                       l[0].get<double>(), l[1].get<double>(), l[2].get<double>());
   }
   for (const auto& w : j["warnings"]) out += "warning   " + w.get<std::string>() + "\n";
   return out;

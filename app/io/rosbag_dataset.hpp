@@ -1,10 +1,7 @@
 #pragma once
 // A drive recorded as a ROS1 bag (gvio --format rosbag, or any file ending in .bag or starting
-// with the bag magic): sensor_msgs/Image or CompressedImage (one camera or a stereo pair),
-// sensor_msgs/Imu and sensor_msgs/NavSatFix. Topics are chosen by type when that is unambiguous,
-// else named in config (dataset.topics.*). Every stream is ordered by header stamp (messages out
-// of order are sorted and counted; repeated stamps dropped and counted). Images stay in the bag
-// and are decoded on request. A bag holds no camera-IMU calibration: images need --calib (Kalibr).
+// with the bag magic), read through librosbag_storage; topics, ordering and pairing as every bag
+// (io/bag_dataset.hpp). A ROS 1 bag holds no camera-IMU calibration: images need --calib (Kalibr).
 #include <filesystem>
 
 #include "io/dataset.hpp"

@@ -66,12 +66,17 @@ void loadDataset(RunState& s) {
   s.gnss_noise = degradeGnss(s.dataset, s.request);
 }
 
+Eigen::Vector3d gnssLeverArm(const Eigen::Vector3d& configured, const io::Dataset& ds) {
+  return configured.isZero() && ds.gnss_lever_arm_b ? *ds.gnss_lever_arm_b : configured;
+}
+
 // No camera frames but an IMU and GNSS: GNSS/INS on the IMU (run/ins_run.hpp) instead of VIO.
 bool runGnssInsInstead(RunState& s) {
   const io::Dataset& ds = s.dataset;
   if (!wantsGnssIns(ds) || s.request.gnss == "off") return false;
   const ImuConfig::Choice imu_noise = s.config.imu.choose(ds.imu_noise);
-  const fusion::InsConfig ins = s.config.fusion.insConfig(imu_noise.noise);
+  fusion::InsConfig ins = s.config.fusion.insConfig(imu_noise.noise);
+  ins.lever_arm_b = gnssLeverArm(ins.lever_arm_b, ds);
   const fs::path& out = s.request.out;
   spdlog::info("{} {} ({}): no camera frames, {} IMU samples, {} fixes: GNSS/INS",
                io::toString(ds.format), ds.root.string(), ds.variant, ds.imu.size(),

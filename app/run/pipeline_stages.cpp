@@ -41,6 +41,7 @@ void runVioStage(RunState& s) {
   s.estimator = s.config.vio.estimator;
   s.estimator.mode = chooseVioMode(s.config.vio.mode, ds);
   s.fusion = s.config.fusion.fusionFor(s.estimator.mode);
+  s.fusion.lever_arm_b = gnssLeverArm(s.fusion.lever_arm_b, ds);
   const ImuConfig::Choice imu_noise = s.config.imu.choose(ds.imu_noise);
   s.estimator.imu_noise = imu_noise.noise;
   s.estimator.validate();

@@ -53,6 +53,9 @@ void loadDataset(RunState& s);
 // Runs GNSS/INS when the dataset has no camera but an IMU and fixes (and --gnss is not off);
 // returns false when the dataset is for the VIO stages.
 bool runGnssInsInstead(RunState& s);
+// The GNSS antenna's lever arm: fusion.lever_arm_b when set (non-zero), else the recording's
+// (a ROS 2 bag's /tf_static), else zero.
+Eigen::Vector3d gnssLeverArm(const Eigen::Vector3d& configured, const io::Dataset& ds);
 // The estimator configuration, the keyframe recorders, the VIO over the whole dataset;
 // trajectory_vio.tum (and groundtruth.tum) written.
 void runVioStage(RunState& s);

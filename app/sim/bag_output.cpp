@@ -18,6 +18,10 @@ const char* const kImageTopics[] = {"/cam0/image_raw", "/cam1/image_raw"};
 constexpr const char* kImuTopic = "/imu0";
 constexpr const char* kGnssTopic = "/gnss/fix";
 
+io::bag::Stamps stamps(std::int64_t t_ns) {
+  return {t_ns, t_ns};
+}
+
 // x rounded to `decimals` decimal places: the very double a text reader gets from the EuRoC
 // writer's "{:.<decimals>f}" (through the same decimal text: x * 10^d in binary can round the
 // other way at a tie).
@@ -26,10 +30,6 @@ double rounded(double x, int decimals) {
   double value = 0.0;
   std::from_chars(text.data(), text.data() + text.size(), value);
   return value;
-}
-
-io::bag::Stamps stamps(std::int64_t t_ns) {
-  return {t_ns, t_ns};
 }
 
 // NMEA quality to NavSatFix status: RTK fixed and float are GBAS fixes (as ROS drivers report
@@ -41,6 +41,29 @@ int navSatStatus(int quality) {
 }
 
 }  // namespace
+
+io::bag::ImuMessage bagImuMessage(const ImuSimSample& s) {
+  io::bag::ImuMessage m;
+  m.t = stamps(s.measured.t_ns);
+  for (int i = 0; i < 3; ++i) {
+    m.acc_mps2[static_cast<std::size_t>(i)] = rounded(s.measured.acc_b_mps2[i], 12);
+    m.gyr_radps[static_cast<std::size_t>(i)] = rounded(s.measured.gyr_b_radps[i], 12);
+  }
+  return m;
+}
+
+io::bag::NavSatFixMessage bagFixMessage(const GnssFix& f) {
+  io::bag::NavSatFixMessage m;
+  m.t = stamps(f.t_ns);
+  m.status = navSatStatus(f.quality);
+  m.lat_deg = rounded(f.lat_deg, 10);
+  m.lon_deg = rounded(f.lon_deg, 10);
+  m.alt_m = rounded(f.h_ellipsoid_m, 4);
+  const double sigma_h = rounded(f.sigma_h_m, 4), sigma_v = rounded(f.sigma_v_m, 4);
+  m.covariance_enu_m2 = {sigma_h * sigma_h, 0, 0, 0, sigma_h * sigma_h, 0, 0, 0, sigma_v * sigma_v};
+  m.covariance_type = 2;  // COVARIANCE_TYPE_DIAGONAL_KNOWN
+  return m;
+}
 
 Eigen::Isometry3d asEurocWrites(const Eigen::Isometry3d& T_b_c) {
   Eigen::Isometry3d T = T_b_c;
@@ -73,28 +96,8 @@ void BagOutput::finish(const std::vector<ImuSimSample>& imu, const std::vector<G
                        const std::vector<CameraModel>& cameras, const ImuNoise& noise,
                        double imu_rate_hz) {
   try {
-    for (const ImuSimSample& s : imu) {
-      io::bag::ImuMessage m;
-      m.t = stamps(s.measured.t_ns);
-      for (int i = 0; i < 3; ++i) {
-        m.acc_mps2[static_cast<std::size_t>(i)] = rounded(s.measured.acc_b_mps2[i], 12);
-        m.gyr_radps[static_cast<std::size_t>(i)] = rounded(s.measured.gyr_b_radps[i], 12);
-      }
-      writer_->write(kImuTopic, m);
-    }
-    for (const GnssFix& f : fixes) {
-      io::bag::NavSatFixMessage m;
-      m.t = stamps(f.t_ns);
-      m.status = navSatStatus(f.quality);
-      m.lat_deg = rounded(f.lat_deg, 10);
-      m.lon_deg = rounded(f.lon_deg, 10);
-      m.alt_m = rounded(f.h_ellipsoid_m, 4);
-      const double sigma_h = rounded(f.sigma_h_m, 4), sigma_v = rounded(f.sigma_v_m, 4);
-      m.covariance_enu_m2 = {sigma_h * sigma_h, 0, 0, 0, sigma_h * sigma_h, 0, 0, 0,
-                             sigma_v * sigma_v};
-      m.covariance_type = 2;  // COVARIANCE_TYPE_DIAGONAL_KNOWN
-      writer_->write(kGnssTopic, m);
-    }
+    for (const ImuSimSample& s : imu) writer_->write(kImuTopic, bagImuMessage(s));
+    for (const GnssFix& f : fixes) writer_->write(kGnssTopic, bagFixMessage(f));
     writer_->close();
   } catch (const io::bag::BagError& e) {
     throw io::InputError(temporary_, 0, e.what());

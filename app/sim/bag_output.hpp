@@ -33,6 +33,11 @@ class BagOutput {
   std::unique_ptr<io::bag::BagWriter> writer_;
 };
 
+// An IMU sample and a fix as either bag format carries them (stamped with their measurement
+// time), at the EuRoC text's precision.
+io::bag::ImuMessage bagImuMessage(const ImuSimSample& s);
+io::bag::NavSatFixMessage bagFixMessage(const GnssFix& f);
+
 // A camera pose as the EuRoC layout writes it (12 decimals per entry).
 Eigen::Isometry3d asEurocWrites(const Eigen::Isometry3d& T_b_c);
 

@@ -47,6 +47,15 @@ void SimConfig::validate() const {
   require(texture_size_px >= 64 && texture_size_px <= 4096 &&
               (texture_size_px & (texture_size_px - 1)) == 0,
           "texture_size_px", "a power of two in [64, 4096]", texture_size_px);
+  if (ros2bag_storage != "mcap" && ros2bag_storage != "sqlite3") {
+    throw InvalidInput("config: sim.ros2bag_storage must be mcap or sqlite3 (got '" +
+                       ros2bag_storage + "')");
+  }
+  if (ros2bag_compression != "none" && ros2bag_compression != "lz4" &&
+      ros2bag_compression != "zstd") {
+    throw InvalidInput("config: sim.ros2bag_compression must be none, lz4 or zstd (got '" +
+                       ros2bag_compression + "')");
+  }
   if (!parseWorldStyle(world_style)) {
     throw InvalidInput(fmt::format("config: sim.world_style must be one of {} (got '{}')",
                                    kWorldStyleNames, world_style));

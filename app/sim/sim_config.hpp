@@ -42,6 +42,10 @@ struct SimConfig {
   // Per-drive turn-on biases, 1 sigma per axis (0: the IMU starts unbiased).
   double imu_turn_on_acc_bias_mps2 = 0.0;
   double imu_turn_on_gyr_bias_radps = 0.0;
+  // --format ros2bag: the storage plugin (mcap, sqlite3) and, for MCAP, the chunk compression
+  // (none, lz4, zstd).
+  std::string ros2bag_storage = "mcap";
+  std::string ros2bag_compression = "lz4";
 
   void validate() const;  // throws InvalidInput naming the key
 };

@@ -21,6 +21,7 @@
 #include "sim/gnss_replay.hpp"
 #include "sim/imu_synth.hpp"
 #include "sim/kitti_convention.hpp"
+#include "sim/ros2_bag_output.hpp"
 #include "sim/world.hpp"
 
 namespace gvio::sim {
@@ -253,8 +254,8 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
                     const ProgressFn& progress) {
   config.validate();
   if (r.output != io::DatasetFormat::kKittiRaw && r.output != io::DatasetFormat::kEuroc &&
-      r.output != io::DatasetFormat::kRosbag) {
-    throw InvalidInput("--format: the simulator writes kitti-raw, euroc or rosbag");
+      r.output != io::DatasetFormat::kRosbag && r.output != io::DatasetFormat::kRos2Bag) {
+    throw InvalidInput("--format: the simulator writes kitti-raw, euroc, rosbag or ros2bag");
   }
   if (r.seconds && !(*r.seconds > 0.0)) throw InvalidInput("--seconds must be positive");
   const Drive drive = loadDrive(r, config);
@@ -335,6 +336,9 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
   const bool kitti = r.output == io::DatasetFormat::kKittiRaw;
   std::optional<BagOutput> bag;
   if (r.output == io::DatasetFormat::kRosbag) bag.emplace(r.out);
+  std::optional<Ros2BagOutput> ros2_bag;
+  if (r.output == io::DatasetFormat::kRos2Bag)
+    ros2_bag.emplace(r.out, config, calibrated, imu, fixes);
   std::vector<std::int64_t> frame_t;
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / config.camera_rate_hz));
   for (std::int64_t t = traj.t0_ns(); t <= t1; t += period_ns) frame_t.push_back(t);
@@ -348,6 +352,10 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
       const cv::Mat image = cameras.render(traj, frame_t[k], c, k);
       if (bag) {
         bag->writeImage(stamp_t[k], c, image);
+        continue;
+      }
+      if (ros2_bag) {
+        ros2_bag->writeImage(stamp_t[k], c, image);
         continue;
       }
       const fs::path file =
@@ -368,6 +376,8 @@ SimSummary simulate(const SimRequest& r, const SimConfig& config, const ImuNoise
     io::writeTextAtomic(r.out / "gnss" / "data.csv", toGnssCsv(fixes));
   } else if (bag) {
     bag->finish(imu, fixes, calibrated, summary.imu_noise.noise, config.imu_rate_hz);
+  } else if (ros2_bag) {
+    ros2_bag->finish(summary.imu_noise.noise, config.imu_rate_hz);
   } else {
     for (std::size_t c = 0; c < ids.size(); ++c)
       writeEurocCamera(r.out, ids[c], stamp_t, K, T_b_c[c], config.camera_rate_hz);

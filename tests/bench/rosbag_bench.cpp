@@ -4,12 +4,12 @@
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
-#include <opencv2/core.hpp>
 #include <random>
 
 #include "io/dataset.hpp"
 #include "io/ros_image.hpp"
 #include "io/rosbag/bag_file.hpp"
+#include "support/camera_like.hpp"
 #include "support/fixtures.hpp"
 
 namespace gvio::io {
@@ -17,27 +17,12 @@ namespace {
 
 constexpr int kImages = 40;
 
-// Camera-like content: smooth structure plus sensor noise (noise alone would not compress at
-// all, a flat image far too well).
-cv::Mat cameraLike(int k, std::mt19937& rng) {
-  cv::Mat image(376, 1241, CV_8UC1);
-  std::normal_distribution<double> noise(0.0, 2.0);
-  for (int r = 0; r < image.rows; ++r) {
-    auto* row = image.ptr<std::uint8_t>(r);
-    for (int c = 0; c < image.cols; ++c) {
-      const double v = 128 + 60 * std::sin(0.05 * (c + 7 * k)) * std::cos(0.07 * r) + noise(rng);
-      row[c] = cv::saturate_cast<std::uint8_t>(v);
-    }
-  }
-  return image;
-}
-
 // kImages camera-like images on /cam0/image_raw at 10 Hz in a bag of the given compression.
 void writeImageBag(const std::filesystem::path& file, bag::Compression compression) {
   std::mt19937 rng(1);
   bag::BagWriter writer(file.string(), compression);
   for (int k = 0; k < kImages; ++k) {
-    bag::ImageMessage m = grayToRosImage(cameraLike(k, rng), false);
+    bag::ImageMessage m = grayToRosImage(test::cameraLike(k, rng), false);
     const std::int64_t t_ns = 1'000'000'000 + k * 100'000'000LL;
     m.t = {t_ns, t_ns};
     writer.write("/cam0/image_raw", m);

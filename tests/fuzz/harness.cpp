@@ -77,6 +77,7 @@ const std::vector<Target>& targets() {
     addTextTargets(list);
     addFileTargets(list);
     addFleetTargets(list);
+    addRos2Targets(list);
     return list;
   }();
   return all;

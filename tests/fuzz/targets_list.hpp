@@ -17,5 +17,6 @@ Target plain(std::string name, std::string file, std::string seed,
 std::string smallCamchainYaml();
 void addFileTargets(std::vector<Target>& out);   // targets_files.cpp
 void addFleetTargets(std::vector<Target>& out);  // targets_fleet.cpp
+void addRos2Targets(std::vector<Target>& out);   // targets_ros2.cpp
 
 }  // namespace gvio::fuzz
