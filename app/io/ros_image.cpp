@@ -25,6 +25,16 @@ Layout layoutOf(const std::string& encoding) {
   if (encoding == "rgb8") return {CV_8UC3, 3, cv::COLOR_RGB2GRAY};
   if (encoding == "bgra8") return {CV_8UC4, 4, cv::COLOR_BGRA2GRAY};
   if (encoding == "rgba8") return {CV_8UC4, 4, cv::COLOR_RGBA2GRAY};
+  // Colour filter arrays, named by their first row (ROS) where OpenCV names the second row's
+  // pattern: bayer_rggb8 is OpenCV's BayerBG (as cv_bridge maps them).
+  if (encoding == "bayer_rggb8") return {CV_8UC1, 1, cv::COLOR_BayerBG2GRAY};
+  if (encoding == "bayer_bggr8") return {CV_8UC1, 1, cv::COLOR_BayerRG2GRAY};
+  if (encoding == "bayer_gbrg8") return {CV_8UC1, 1, cv::COLOR_BayerGR2GRAY};
+  if (encoding == "bayer_grbg8") return {CV_8UC1, 1, cv::COLOR_BayerGB2GRAY};
+  if (encoding == "bayer_rggb16") return {CV_16UC1, 2, cv::COLOR_BayerBG2GRAY};
+  if (encoding == "bayer_bggr16") return {CV_16UC1, 2, cv::COLOR_BayerRG2GRAY};
+  if (encoding == "bayer_gbrg16") return {CV_16UC1, 2, cv::COLOR_BayerGR2GRAY};
+  if (encoding == "bayer_grbg16") return {CV_16UC1, 2, cv::COLOR_BayerGB2GRAY};
   throw InvalidInput(
       fmt::format("image encoding '{}' is not supported ({})", encoding, kRosImageEncodings));
 }
@@ -35,6 +45,10 @@ cv::Mat rawToGray(const bag::ImageMessage& m) {
       std::uint64_t{m.width} * static_cast<unsigned>(layout.bytes_per_pixel);
   if (m.width == 0 || m.height == 0 || m.width > 65535 || m.height > 65535) {
     throw InvalidInput(fmt::format("image of {}x{} pixels", m.width, m.height));
+  }
+  const bool bayer = m.encoding.rfind("bayer_", 0) == 0;
+  if (bayer && (m.width < 2 || m.height < 2)) {  // a colour filter's 2x2 cell must fit
+    throw InvalidInput(fmt::format("{} image of {}x{} pixels", m.encoding, m.width, m.height));
   }
   if (m.step < row_bytes || std::uint64_t{m.step} * m.height > m.data.size()) {
     throw InvalidInput(fmt::format("{}x{} {} image with step {} does not fit its {} bytes of data",
@@ -59,8 +73,13 @@ cv::Mat rawToGray(const bag::ImageMessage& m) {
           row[c] = static_cast<std::uint16_t>((row[c] >> 8) | (row[c] << 8));
       }
     }
+    cv::Mat scaled;
+    wide.convertTo(scaled, CV_8U, 1.0 / 256.0);
+    if (layout.to_gray < 0) return scaled;
+    // 16-bit Bayer demosaiced after the scaling: OpenCV's 16-bit Bayer-to-grey leaves a 2-pixel
+    // pattern of up to 8 % on a uniform colour where its 8-bit one is exact.
     cv::Mat gray;
-    wide.convertTo(gray, CV_8U, 1.0 / 256.0);
+    cv::cvtColor(scaled, gray, layout.to_gray);
     return gray;
   }
   if (layout.to_gray < 0) return view.clone();

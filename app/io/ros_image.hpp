@@ -12,7 +12,8 @@ namespace gvio::io {
 
 // Encodings accepted from sensor_msgs/Image (named in errors).
 inline constexpr const char* kRosImageEncodings =
-    "mono8, 8UC1, mono16, 16UC1, bgr8, rgb8, bgra8, rgba8";
+    "mono8, 8UC1, mono16, 16UC1, bgr8, rgb8, bgra8, rgba8, bayer_rggb8, bayer_bggr8, bayer_gbrg8, "
+    "bayer_grbg8 (and their 16-bit forms)";
 
 // Throws InvalidInput saying what is wrong: an unsupported encoding or compressed format, a
 // step or data size that does not fit the image, an undecodable compressed payload.

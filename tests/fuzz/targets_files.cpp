@@ -211,7 +211,8 @@ void readRosImage(const fs::path& d) {
   std::vector<std::uint8_t> b((std::istreambuf_iterator<char>(in)), {});
   if (b.size() < 5) return;
   static const std::vector<std::string> kEncodings = {
-      "mono8", "8UC1", "mono16", "16UC1", "bgr8", "rgb8", "bgra8", "rgba8", "yuv422", "32FC1"};
+      "mono8", "8UC1",  "mono16",      "16UC1",        "bgr8",   "rgb8",
+      "bgra8", "rgba8", "bayer_rggb8", "bayer_grbg16", "yuv422", "32FC1"};
   io::bag::ImageMessage m;
   const std::size_t kind = b[0] % (kEncodings.size() + 3);
   m.compressed = kind >= kEncodings.size();

@@ -106,8 +106,8 @@ TEST(RosImage, CompressedPngAndJpeg) {
 
 TEST(RosImage, RefusalsSayWhatIsWrong) {
   const cv::Mat g = gradient();
-  EXPECT_THAT(error(raw(g, "bayer_rggb8")),
-              HasSubstr("image encoding 'bayer_rggb8' is not supported (mono8, 8UC1"));
+  EXPECT_THAT(error(raw(g, "yuv422")),
+              HasSubstr("image encoding 'yuv422' is not supported (mono8, 8UC1"));
   bag::ImageMessage short_data = raw(g, "mono8");
   short_data.data.resize(short_data.data.size() - 1);
   EXPECT_THAT(error(short_data), HasSubstr("does not fit its 59 bytes"));
@@ -160,6 +160,37 @@ TEST(RosImage, OversizedHeadersAreRefusedNotThrown) {
   const std::array<std::uint8_t, 4> wide = {0x00, 0x1E, 0x84, 0x80};  // 2,000,000
   std::copy(wide.begin(), wide.end(), png.data.begin() + 16);         // IHDR width
   EXPECT_THAT(error(png), HasSubstr("PNG of 2000000x6 px (each side must be 1 to 1000000)"));
+}
+
+// A colour filter array of one colour (R 200, G 100, B 50), demosaiced to grey: OpenCV's weights
+// where the pattern is read right (a pattern read as another one swaps red and blue: 96 not 124).
+TEST(RosImage, BayerPatternsDemosaicToGrey) {
+  const double expected = 0.299 * 200 + 0.587 * 100 + 0.114 * 50;
+  const std::pair<const char*, std::array<int, 4>> kPatterns[] = {
+      {"bayer_rggb", {200, 100, 100, 50}},  // the 2x2 cell: top left, top right, bottom left, ...
+      {"bayer_bggr", {50, 100, 100, 200}},
+      {"bayer_gbrg", {100, 50, 200, 100}},
+      {"bayer_grbg", {100, 200, 50, 100}}};
+  for (const auto& [name, cell] : kPatterns) {
+    cv::Mat mosaic(8, 12, CV_8UC1);
+    cv::Mat wide(8, 12, CV_16UC1);
+    for (int r = 0; r < mosaic.rows; ++r) {
+      for (int c = 0; c < mosaic.cols; ++c) {
+        const int v = cell[static_cast<std::size_t>(2 * (r % 2) + c % 2)];
+        mosaic.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(v);
+        wide.at<std::uint16_t>(r, c) = static_cast<std::uint16_t>(v * 256);
+      }
+    }
+    for (const auto& [image, bits] : {std::pair{mosaic, "8"}, std::pair{wide, "16"}}) {
+      const cv::Mat gray = rosImageToGray(raw(image, std::string(name) + bits));
+      ASSERT_EQ(gray.size(), mosaic.size());
+      // Interior pixels (the demosaic's border is an extrapolation).
+      EXPECT_NEAR(gray.at<std::uint8_t>(4, 6), expected, 1.5) << name << bits;
+      EXPECT_NEAR(gray.at<std::uint8_t>(3, 5), expected, 1.5) << name << bits;
+    }
+  }
+  bag::ImageMessage tiny = raw(cv::Mat(1, 4, CV_8UC1, cv::Scalar(9)), "bayer_rggb8");
+  EXPECT_THAT(error(tiny), HasSubstr("bayer_rggb8 image of 4x1 pixels"));
 }
 
 }  // namespace
