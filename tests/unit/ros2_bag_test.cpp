@@ -159,6 +159,26 @@ TEST(Ros2Bag, RefusesWhatIsNotABag) {
   }
 }
 
+// A channel whose schema says Imu but whose messages are NavSatFix: refused naming the message.
+TEST(Ros2Bag, AMessageOfAnotherTypeThanItsSchemaIsRefused) {
+  test::TempDir dir("ros2_bag_schema");
+  {
+    Ros2BagWriter writer(dir.path(), "drive", Ros2Storage::kMcap, "none");
+    const std::size_t imu = writer.addTopic("/imu", kRos2ImuType);
+    Ros2NavSatFix fix;
+    fix.fix.t.header_ns = 1'000'000'000;
+    fix.frame_id = "gps";
+    writer.write(imu, 1'000'000'000, encodeNavSatFix(fix));
+    writer.close();
+  }
+  try {
+    (void)readRos2Bag(dir.path(), ReaderConfig{});
+    FAIL() << "a NavSatFix was read as an Imu";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr(dir.path().string() + ": topic /imu: message 0: "));
+  }
+}
+
 Eigen::Isometry3d pose(double yaw, const Eigen::Vector3d& t) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
