@@ -91,7 +91,10 @@ json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportCon
   std::string distortion = "none";
   const std::size_t used = odometry::usesStereo(run.mode) ? 2 : 1;
   for (std::size_t i = 0; i < std::min(used, ds.cameras.size()); ++i) {
-    if (hasLensDistortion(ds.cameras[i])) distortion = toString(ds.cameras[i].distortion_model);
+    const CameraModel& cam = ds.cameras[i];
+    if (!hasLensDistortion(cam)) continue;
+    distortion =
+        cam.distortion.size() == 8 ? "rational_polynomial" : toString(cam.distortion_model);
   }
   report["rectification"] = {{"identity", run.rectification_identity},
                              {"baseline_m", run.baseline_m},

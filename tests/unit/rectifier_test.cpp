@@ -86,6 +86,30 @@ TEST(RectifierTest, DistortedMonoCameraIsUndistorted) {
   EXPECT_EQ(hi, 200.0);
 }
 
+// ROS's rational_polynomial (OpenCV's 8 coefficients k1 k2 p1 p2 k3 k4 k5 k6), as a ROS 2 bag's
+// CameraInfo states it: rectified like the 5-coefficient model, the maps sampling where the
+// 8-coefficient model projects.
+TEST(RectifierTest, RationalPolynomialCamerasAreRectified) {
+  CameraModel raw_l = eurocCam0(), raw_r = eurocCam1();
+  for (CameraModel* c : {&raw_l, &raw_r}) {
+    c->distortion = {c->distortion[0],
+                     c->distortion[1],
+                     c->distortion[2],
+                     c->distortion[3],
+                     0.01,
+                     0.05,
+                     -0.02,
+                     0.01};
+  }
+  const Rectifier mono(raw_l);
+  EXPECT_TRUE(mono.left().distortion.empty());
+  EXPECT_LT(worstMapError(mono, raw_l, std::nullopt, false), 0.05);
+  const Rectifier stereo(raw_l, raw_r);
+  expectStereoContract(stereo, raw_l, raw_r);
+  EXPECT_LT(worstMapError(stereo, raw_l, raw_r, false), 0.05);
+  EXPECT_LT(worstMapError(stereo, raw_l, raw_r, true), 0.05);
+}
+
 TEST(RectifierTest, RectifiedKittiPairPassesThrough) {
   const CameraModel raw_l = kittiCam0(), raw_r = kittiCam1();
   const Rectifier rect(raw_l, raw_r);
