@@ -71,11 +71,15 @@ TEST(CliRos2Bag, McapSqliteAndTheFolderGiveTheEurocRun) {
   // The ROS 1 bag of the same seed, with the same Kalibr files.
   const fs::path ros1 = test::cachedSimulation(kDrive + " --format rosbag");
   const fs::path from_ros1 = run(ros1 / "drive.bag", kalibr, "ros1");
+  // And the EuRoC folder given the same Kalibr files (which replace its sensor.yaml's cameras).
+  const fs::path from_euroc_kalibr = run(euroc, kalibr, "euroc_kalibr");
   for (const char* file : {"trajectory_vio.tum", "trajectory.tum"}) {
-    // The storages and the folder: the same bytes; so are ROS 1 and ROS 2 given one calibration.
+    // The storages and the folder: the same bytes; so are ROS 2, ROS 1 and the EuRoC folder given
+    // one calibration.
     EXPECT_EQ(test::readText(from_folder / file), test::readText(from_mcap / file)) << file;
     EXPECT_EQ(test::readText(from_folder / file), test::readText(from_db3 / file)) << file;
     EXPECT_EQ(test::readText(from_kalibr / file), test::readText(from_ros1 / file)) << file;
+    EXPECT_EQ(test::readText(from_kalibr / file), test::readText(from_euroc_kalibr / file)) << file;
     // The calibration's own representations differ in their last bits (a quaternion in
     // /tf_static, 12 decimals in EuRoC's sensor.yaml, Kalibr's inverted T_cam_imu): the poses
     // then agree to one unit of the last digit TUM prints (1e-9, parsed back with its rounding).
