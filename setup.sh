@@ -12,6 +12,8 @@
 #                      SANITIZE_EXCLUDE (a ctest -E regex) skips tests of the ASan run
 #   ./setup.sh fuzz [SECONDS [TARGET...]]
 #                      every libFuzzer target (tests/fuzz) for SECONDS each (default 60)
+#   ./setup.sh docs    the documentation site (MkDocs, strict) into build/site, and a check of
+#                      every relative link and image in README.md
 # Idempotent and non-interactive. Environment: BUILD_DIR (default build), JOBS (default nproc).
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -36,6 +38,8 @@ TEST_PACKAGES=(libgtest-dev libgmock-dev libbenchmark-dev)
 # Sanitizers and libFuzzer come with clang.
 SANITIZER_PACKAGES=(clang-14 libfuzzer-14-dev libclang-rt-14-dev)
 case "$mode" in sanitize | fuzz) PACKAGES+=("${SANITIZER_PACKAGES[@]}") ;; esac
+# The documentation site needs nothing of the build: MkDocs and its Material theme alone.
+[ "$mode" = docs ] && PACKAGES=(mkdocs mkdocs-material python3)
 
 install_packages() {
   local missing=()
@@ -141,6 +145,12 @@ case "$mode" in
   fuzz)
     fuzz "${@:2}"
     ;;
+  docs)
+    # Strict: a broken link, a page missing from the nav or any other warning fails the build.
+    # The generated references (docs/reference/) are checked against the program by ctest.
+    mkdocs build --strict --site-dir "$BUILD_DIR/site"
+    python3 tests/tools/check_markdown_links.py README.md CHANGELOG.md
+    ;;
   demo)
     build
     # Simulate 20 s of the embedded drive (stereo, IMU, SPP GNSS, exact truth), then validate it.
@@ -152,7 +162,7 @@ case "$mode" in
     # directly comparable with its truth (report.json evaluation_fused).
     "$BUILD_DIR/app/gvio" run --dataset out/demo/drive --gnss graph --out out/demo/run \
       --set fusion.origin=48.98253,8.39035,116.4 --set "fusion.lever_arm_b=[0,0,0.8]"
-    # The views shown in README.md (docs/images/ holds copies): trajectory error, and the map from
+    # The views shown in the docs (docs/images/ holds copies): trajectory error, and the map from
     # above, in perspective, as OctoMap voxels and over a camera image.
     for view in error topdown perspective octomap; do
       "$BUILD_DIR/app/gvio" render --run out/demo/run --view "$view" --out "out/demo/run/render/$view.png"

@@ -18,7 +18,7 @@ using tracker_detail::upperMedian;
 namespace {
 
 // Half side of the patches whose ZNCC checks a stereo match (11 x 11, the size that separated
-// the wrong matches from the correct ones in docs/vio_matrix.md).
+// the wrong matches from the correct ones in docs/benchmarks/vio-matrix.md).
 constexpr int kZnccHalfPx = 5;
 
 // Zero-mean normalised cross-correlation of the (2 half + 1)^2 patches of `a` around `pa` and of

@@ -34,7 +34,7 @@ constexpr double kRansacConfidence = 0.99;
 // a frame rejected; likely reverse tracks that cannot leave their origin's neighbourhood), and the
 // style matrix's sparse texture drives lose (seeds 1-3: 0.100 / 0.088 / 0.076 % of the path with
 // one level, 0.178 / 0.105 / 0.227 % with none, 0.126 / 0.104 / 0.075 % with two;
-// docs/vio_matrix.md, "Fewer KLT levels").
+// docs/benchmarks/vio-matrix.md, "Fewer KLT levels").
 constexpr int kReverseLevels = 1;
 
 // Exposure gain: ratios of 9 x 9 patch means (small enough to stay on the tracked surface), and

@@ -24,7 +24,7 @@ struct TrackerConfig {
   // on one core); level 1 takes a quarter of it. Not the default: stereo+IMU gained (style matrix
   // geometric mean 0.0403 -> 0.0335 %, KITTI-00 1.105 -> 0.921 m) and mono+IMU a little, stereo
   // alone lost, and on the slanted-plane test one of its corners gets a stereo match 8 px off
-  // that the checks pass (docs/vio_matrix.md, "Corners from the half-resolution level").
+  // that the checks pass (docs/benchmarks/vio-matrix.md, "Corners from the half-resolution level").
   int detect_level = 0;
   // A new corner is dropped when the smaller eigenvalue of its gradient covariance over a 7 x 7
   // window (the full-resolution KLT pass's) is below this fraction of the larger one (0: no
@@ -35,7 +35,7 @@ struct TrackerConfig {
   // epipolar lines, so the fundamental-matrix RANSAC cannot catch the slide either. 0.1 took
   // stereo+IMU from 27 to 29 of the style matrix's 30 cells within 0.10 % (six seeds), but the
   // whole KITTI-00 drive over four simulations from 0.904 to 1.161 m (geometric mean): off by
-  // default (docs/vio_matrix.md, "Held-out seeds" and "Four simulations of KITTI-00").
+  // default (docs/benchmarks/vio-matrix.md, "Held-out seeds" and "Four simulations of KITTI-00").
   double min_eigen_ratio = 0.0;
   int klt_window_px = 21;  // odd side of the KLT window
   int klt_levels = 3;      // pyramid levels above the full-resolution image
@@ -58,7 +58,7 @@ struct TrackerConfig {
   // Rectified stereo: a match further than this from the frame's median row offset (right y -
   // left y over its candidate matches) is rejected. KLT on an oblique edge (a lane marking, a
   // wall's edge) slides along it, off the row and to a wrong disparity; the median is the offset
-  // a rig's rectification error gives every match alike (docs/vio_matrix.md, "The stereo row
+  // a rig's rectification error gives every match alike (docs/benchmarks/vio-matrix.md, "The stereo row
   // check").
   double stereo_max_vertical_px = 0.5;
   // A stereo match is dropped when the zero-mean normalised cross-correlation of the 11 x 11
@@ -67,7 +67,7 @@ struct TrackerConfig {
   // forward-backward check (its reverse pass starts at the left pixel itself) and the row check
   // pass it: 8 px and 67 px wrong matches on the slanted-plane test scored 0.66 and 0.61, every
   // correct match there 0.77 or more, and 99.8 % of KITTI-00's matches 0.7 or more
-  // (docs/vio_matrix.md, "Corners from the half-resolution level").
+  // (docs/benchmarks/vio-matrix.md, "Corners from the half-resolution level").
   double stereo_min_zncc = -1.0;
   // Exposure changes (odometry/photometric_gain.hpp): when the median brightness ratio of the
   // matched patches between the previous and this left image (or between the left and the right

@@ -53,7 +53,7 @@ struct EstimatorConfig {
   double min_depth_m = 0.5;  // landmarks closer or further are not used
   // Far points barely constrain translation but are the best reference for rotation: 1000 m
   // (0.39 px of disparity on KITTI's stereo pair) keeps what the stereo match and the
-  // triangulation give; 80 m before (docs/vio_matrix.md, "Each observation counted once").
+  // triangulation give; 80 m before (docs/benchmarks/vio-matrix.md, "Each observation counted once").
   double max_depth_m = 1000.0;
   FoldedLandmarks folded_landmarks = FoldedLandmarks::kAuto;  // see foldedLandmarksDropped()
   double max_reprojection_px = 3.0;  // landmarks with a larger residual after solving are dropped
@@ -86,7 +86,7 @@ struct EstimatorConfig {
   // is applied to the stamps before the estimator sees them). On synchronised drives it costs
   // about 1 % APE over the style matrix (KITTI-00: APE 5 % better, RPE 15 % worse, as the estimate
   // wanders on straight stretches); unestimated, a 20 ms lag costs 2x on a car drive and 100x in a
-  // slalom (README, "Camera-IMU time offset").
+  // slalom (docs/how-it-works/time-offset.md).
   bool estimate_time_offset = true;
   double time_offset_sigma_s = 0.05;
   // Random walk of t_d (s/sqrt(s)) added to its marginal at every marginalisation: on a car, t_d is
@@ -109,14 +109,14 @@ struct EstimatorConfig {
   // one's. Where the motion is weakly excited the cost is nearly flat in t_d, and one solve can
   // move it far and the next bring it back (the demo drive's turn exit with a 15 px KLT window and
   // holds off: -3.8 -> -16.1 -> +0.3 ms): a hold starting after such a solve kept the outlier for
-  // the whole straight that followed (README, "Camera-IMU time offset"). 1: the last solve's.
+  // the whole straight that followed (docs/how-it-works/time-offset.md). 1: the last solve's.
   int time_offset_hold_median_solves = 10;
 
   // max_iterations, or by mode when 0: 2 with stereo+IMU, 4 otherwise. Measured, not derived:
   // with stereo+IMU two iterations gave KITTI-00 3.316 -> 3.225 m APE with 27 % less estimator
   // time and 14 of the 15 style-matrix drives better (the window solves each frame again at every
   // frame it stays in; why fewer per frame is better was not isolated). Stereo alone and mono+IMU
-  // were not better with fewer (docs/vio_matrix.md, "Fewer solver iterations per frame").
+  // were not better with fewer (docs/benchmarks/vio-matrix.md, "Fewer solver iterations per frame").
   [[nodiscard]] int solverIterations() const;
   // folded_landmarks, or by mode when kAuto: dropped with the IMU, where re-counting their
   // observations lets the vision pull the tilt / accelerometer-bias pair that a straight drive

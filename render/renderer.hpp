@@ -14,7 +14,7 @@ namespace gvio::render {
 
 struct UploadOptions {
   // Anisotropic texture filtering keeps grazing-angle texture (the road) sharp, but on llvmpipe
-  // 8x costs ~6x the frame time of a KITTI-sized view (README, render benchmark); 1 = off.
+  // 8x costs ~6x the frame time of a KITTI-sized view (docs/how-it-works/renderer.md); 1 = off.
   float max_anisotropy = 1.0F;
 };
 

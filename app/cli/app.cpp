@@ -102,12 +102,12 @@ AppConfig ConfigOptions::load() const {
   return loadConfig(sources);
 }
 
-int runMain(int argc, char** argv) {
-  CLI::App app{"gvio: GNSS-assisted visual-inertial odometry, georeferenced maps and evaluation",
-               "gvio"};
+Cli buildCli(CommonOptions& common) {
+  Cli cli;
+  cli.app = std::make_unique<CLI::App>(
+      "gvio: GNSS-assisted visual-inertial odometry, georeferenced maps and evaluation", "gvio");
+  CLI::App& app = *cli.app;
   app.set_version_flag("--version", std::string(GVIO_VERSION));
-  CommonOptions common;
-  common.command_line = commandLine(argc, argv);
   app.add_flag("-v,--verbose", common.verbose, "More log output (-vv: trace)");
   app.add_flag("-q,--quiet", common.quiet,
                "Warnings and errors only (-qq: errors only), no progress");
@@ -119,7 +119,7 @@ int runMain(int argc, char** argv) {
       "(SIGINT/SIGTERM).");
 
   // Each subcommand is registered here only once it really works.
-  std::vector<Command> commands;
+  std::vector<Command>& commands = cli.commands;
   commands.push_back(addInspectCommand(app, common));
   commands.push_back(addEvalCommand(app));
   commands.push_back(addRenderCommand(app, common));
@@ -130,6 +130,14 @@ int runMain(int argc, char** argv) {
   commands.push_back(addFleetCommand(app));
   commands.push_back(addFleetTaskCommand(app));
   commands.push_back(addMergeCommand(app));
+  return cli;
+}
+
+int runMain(int argc, char** argv) {
+  CommonOptions common;
+  common.command_line = commandLine(argc, argv);
+  const Cli cli = buildCli(common);
+  CLI::App& app = *cli.app;
 
   try {
     app.parse(argc, argv);
@@ -138,7 +146,7 @@ int runMain(int argc, char** argv) {
   }
   setupLogging(common);
   ignoreFileSizeSignal();
-  for (const auto& command : commands) {
+  for (const auto& command : cli.commands) {
     if (command.app->parsed()) return runGuarded(command.run);
   }
   return 2;

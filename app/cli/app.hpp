@@ -2,6 +2,7 @@
 // The gvio command line: global flags, subcommand registration, exit codes
 // (0 ok, 2 bad usage or bad input, 1 internal error).
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -46,6 +47,16 @@ Command addConsistencyCommand(CLI::App& app, const CommonOptions& common);
 Command addFleetCommand(CLI::App& app);
 Command addFleetTaskCommand(CLI::App& app);
 Command addMergeCommand(CLI::App& app);
+
+// The whole command line, every subcommand registered, not yet parsed: runMain parses it, and the
+// CLI reference (docs/reference/cli.md, tests/unit/docs_reference_test.cpp) lists its subcommands
+// from it rather than from a copy that could go stale. The commands refer to `common`, which must
+// outlive them.
+struct Cli {
+  std::unique_ptr<CLI::App> app;  // CLI::App can be neither copied nor moved
+  std::vector<Command> commands;
+};
+Cli buildCli(CommonOptions& common);
 
 int runMain(int argc, char** argv);
 

@@ -100,8 +100,7 @@ Command addRunCommand(CLI::App& app, const CommonOptions& common) {
   sub->add_option("--threads", opt->threads,
                   "Threads (default: the machine's cores); any number gives the same outputs, "
                   "bit for bit, 1 runs every stage in turn")
-      ->check(CLI::Range(1, 256))
-      ->capture_default_str();
+      ->check(CLI::Range(1, 256));  // no "=N" default shown: N is this machine's, not the reader's
   opt->config.addTo(*sub);
   return {sub, [opt, &common] { return runRun(*opt, common); }};
 }

@@ -38,7 +38,7 @@ std::optional<fusion::Lla> FusionAppConfig::originLla() const {
 // The VIO's relative-motion noise in the fusion's graphs by VIO mode. Stereo+IMU: the medians
 // of its relative error (SE(3), 3-D) at 10 m and 100 m over the 15 drives of the style matrix,
 // read as a random walk over keyframe steps of about 0.8 m: 0.2 % + 1 cm and 2e-4 rad per step
-// (KITTI-00 SPP graph 0.913 -> 0.843 m; README "Loop closure"). Mono+IMU (scale drift) and
+// (KITTI-00 SPP graph 0.913 -> 0.843 m; docs/how-it-works/loops.md). Mono+IMU (scale drift) and
 // stereo alone (rotation drift, no tilt from gravity) measured worse with it and keep the
 // library's 0.4 % + 2 cm and 5e-4 rad.
 fusion::FusionConfig FusionAppConfig::fusionFor(std::optional<odometry::VioMode> mode) const {

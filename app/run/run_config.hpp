@@ -22,7 +22,7 @@ struct ImuConfig {
   // Stated figures come from a bench test (Allan variance, a datasheet); on a vehicle vibration
   // and temperature make the noise larger, and the usual practice is to inflate them. On
   // simulated drives whose noise is stated exactly, 1 is best over the style matrix, 1.4 and 2
-  // worse (docs/vio_matrix.md, "The drive's own IMU noise").
+  // worse (docs/benchmarks/vio-matrix.md, "The drive's own IMU noise").
   double dataset_noise_scale = 1.0;
   ImuNoise noise;
 

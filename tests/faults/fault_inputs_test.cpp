@@ -1,4 +1,4 @@
-// The fault matrix, input faults (README "Fault matrix"): one fault in an otherwise valid drive.
+// The fault matrix, input faults (docs/reliability.md): one fault in an otherwise valid drive.
 // A damaged image costs its frame (warned, counted in report.json); everything else the run
 // cannot trust stops it before any output with one line naming the file and line (exit 2).
 #include <fmt/format.h>

@@ -1,4 +1,4 @@
-// The fault matrix, GNSS and output faults (README "Fault matrix"): GNSS that lies, an output
+// The fault matrix, GNSS and output faults (docs/reliability.md): GNSS that lies, an output
 // folder that cannot be written or fills up, and runs stopped by SIGINT, SIGTERM and SIGKILL.
 // Whatever happens, files already in --out are never lost or half-written, no temporary file is
 // left by a run that could clean up, and report.json says whether the run completed.

@@ -53,7 +53,7 @@ TEST(CliTimeOffset, KalibrTimeshiftUndoesALaggingCameraAndTheEstimateIsReported)
   // lagging 0.315 m unestimated and 0.070 m estimated, +18 % (t_d jumped by -13 ms at the
   // turn's exit in both runs). With the hold keeping the median of the last free solves
   // (2026-11-30): synchronised 0.061 m, lagging 0.298 m unestimated and 0.066 m estimated, +9 %
-  // (README, "Camera-IMU time offset"). The bound keeps the estimate from falling further behind.
+  // (docs/how-it-works/time-offset.md). The bound keeps the estimate from falling further behind.
   EXPECT_GT(ape(ignored), 1.3 * ape(estimated)) << ape(estimated);
   EXPECT_LT(ape(estimated), 1.2 * ape(sync)) << ape(sync);
   // The stamps moved back by the shift are the exposures: the synchronised run, bit for bit.
@@ -135,7 +135,7 @@ TEST(CliTimeOffset, AStraightSteadyDriveSaysNotObserved) {
 }
 
 // A slalom (6 m/s, +-1 m at 0.4 Hz, yaw rate up to 1 rad/s) excites the time offset from the
-// start, unlike a straight car drive on which it is unobservable (README). With stamps 20 ms late,
+// start, unlike a straight car drive on which it is unobservable (docs/how-it-works/time-offset.md). With stamps 20 ms late,
 // the estimate must come close to 20 ms and give back most of the APE the lag costs.
 TEST(CliTimeOffset, AnExcitedDriveEstimatesTheLagAndRecoversTheTrajectory) {
   test::TempDir dir("cli_time_offset_slalom");
