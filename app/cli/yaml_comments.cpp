@@ -54,6 +54,9 @@ struct Scan {
   std::string last_key;            // dotted
   std::size_t last_indent = 0;
   bool continuing = false;  // the last key had a trailing comment that may go on below it
+  // A comment block above a run of keys (no blank line between them) is about all of them:
+  // "Geodetic origin ..." above origin_lat_deg, origin_lon_deg and origin_h_m.
+  std::string group;
   std::map<std::string, std::string> comments;
 };
 
@@ -83,10 +86,15 @@ void scanKey(Scan& scan, std::size_t indent, std::string_view content) {
   std::string comment;
   if (hash != std::string_view::npos) {
     comment = commentText(content.substr(hash));
-  } else {
+    scan.group.clear();
+  } else if (!scan.block.empty()) {
     for (const auto& line : scan.block) append(comment, line);
+    scan.group = comment;
+  } else {
+    comment = scan.group;
   }
   if (!comment.empty()) scan.comments[name] = comment;
+  if (trim(body.substr(colon + 1)).empty()) scan.group.clear();  // a section's comment is its own
   scan.block.clear();
   scan.last_key = name;
   scan.last_indent = indent;
@@ -103,8 +111,9 @@ std::map<std::string, std::string> yamlKeyComments(const std::string& yaml_text)
     const std::string_view content = indent == std::string::npos
                                          ? std::string_view()
                                          : trim(std::string_view(line).substr(indent));
-    if (content.empty()) {  // a blank line ends a comment block and a trailing comment
+    if (content.empty()) {  // a blank line ends a comment block, a group and a trailing comment
       scan.block.clear();
+      scan.group.clear();
       scan.continuing = false;
     } else if (content.front() == '#') {
       scanComment(scan, indent, content);

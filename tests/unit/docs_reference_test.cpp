@@ -154,6 +154,7 @@ TEST(DocsReference, YamlCommentsFollowTheFileLayout) {
       {"vio.mode", "above the key, on two lines"},
       {"vio.window", "trailing, wrapped onto the next line"},
       {"vio.tracker.grid", "above a dotted key"},
+      {"vio.bare", "above a dotted key"},  // the group the comment above begins
       {"vio.topic", "the topic"}};
   EXPECT_EQ(cli::yamlKeyComments(yaml), expected);
 }
