@@ -58,8 +58,8 @@ struct TrackerConfig {
   // Rectified stereo: a match further than this from the frame's median row offset (right y -
   // left y over its candidate matches) is rejected. KLT on an oblique edge (a lane marking, a
   // wall's edge) slides along it, off the row and to a wrong disparity; the median is the offset
-  // a rig's rectification error gives every match alike (docs/benchmarks/vio-matrix.md, "The stereo row
-  // check").
+  // a rig's rectification error gives every match alike (docs/benchmarks/vio-matrix.md, "The stereo
+  // row check").
   double stereo_max_vertical_px = 0.5;
   // A stereo match is dropped when the zero-mean normalised cross-correlation of the 11 x 11
   // patches around the left pixel and its match is below this (-1: no check). KLT can stop in a

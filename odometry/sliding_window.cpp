@@ -377,9 +377,9 @@ void SlidingWindow::marginalizeOldest(bool use_imu) {
     // would put those observations into the solve a second time, and again at every later
     // marginalisation: a feature tracked through the whole window then counts up to window_size
     // times, the window grows overconfident in vision, and the tilt / accelerometer-bias pair,
-    // unobservable on a straight, follows whatever the images pull (docs/benchmarks/vio-matrix.md, "Each
-    // observation counted once"). Its track goes on: the next keyframe that sees it starts a new
-    // landmark there. (EstimatorConfig::foldedLandmarksDropped says where it is done.)
+    // unobservable on a straight, follows whatever the images pull (docs/benchmarks/vio-matrix.md,
+    // "Each observation counted once"). Its track goes on: the next keyframe that sees it starts a
+    // new landmark there. (EstimatorConfig::foldedLandmarksDropped says where it is done.)
     if (prior_ && config_.foldedLandmarksDropped()) {
       for (const std::uint64_t id : folded) landmarks_.all().erase(id);
     }

@@ -53,7 +53,8 @@ struct EstimatorConfig {
   double min_depth_m = 0.5;  // landmarks closer or further are not used
   // Far points barely constrain translation but are the best reference for rotation: 1000 m
   // (0.39 px of disparity on KITTI's stereo pair) keeps what the stereo match and the
-  // triangulation give; 80 m before (docs/benchmarks/vio-matrix.md, "Each observation counted once").
+  // triangulation give; 80 m before (docs/benchmarks/vio-matrix.md, "Each observation counted
+  // once").
   double max_depth_m = 1000.0;
   FoldedLandmarks folded_landmarks = FoldedLandmarks::kAuto;  // see foldedLandmarksDropped()
   double max_reprojection_px = 3.0;  // landmarks with a larger residual after solving are dropped
@@ -116,7 +117,8 @@ struct EstimatorConfig {
   // with stereo+IMU two iterations gave KITTI-00 3.316 -> 3.225 m APE with 27 % less estimator
   // time and 14 of the 15 style-matrix drives better (the window solves each frame again at every
   // frame it stays in; why fewer per frame is better was not isolated). Stereo alone and mono+IMU
-  // were not better with fewer (docs/benchmarks/vio-matrix.md, "Fewer solver iterations per frame").
+  // were not better with fewer (docs/benchmarks/vio-matrix.md, "Fewer solver iterations per
+  // frame").
   [[nodiscard]] int solverIterations() const;
   // folded_landmarks, or by mode when kAuto: dropped with the IMU, where re-counting their
   // observations lets the vision pull the tilt / accelerometer-bias pair that a straight drive

@@ -9,7 +9,7 @@ namespace gvio::fleet {
 // --time and --partition/--account (empty: the cluster's default).
 struct SlurmConfig {
   int cpus_per_task = 2;
-  int mem_mb = 4096;         // a KITTI-00-sized drive peaks at about 2 GB (docs/benchmarks/run-time.md)
+  int mem_mb = 4096;  // a KITTI-00-sized drive peaks at about 2 GB (docs/benchmarks/run-time.md)
   int time_limit_min = 120;  // KITTI-00 runs in about 4 minutes on 2 cores
   std::string partition;     // "" = the cluster's default partition
   std::string account;       // "" = the user's default account

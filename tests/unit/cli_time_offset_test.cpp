@@ -135,8 +135,9 @@ TEST(CliTimeOffset, AStraightSteadyDriveSaysNotObserved) {
 }
 
 // A slalom (6 m/s, +-1 m at 0.4 Hz, yaw rate up to 1 rad/s) excites the time offset from the
-// start, unlike a straight car drive on which it is unobservable (docs/how-it-works/time-offset.md). With stamps 20 ms late,
-// the estimate must come close to 20 ms and give back most of the APE the lag costs.
+// start, unlike a straight car drive on which it is unobservable
+// (docs/how-it-works/time-offset.md). With stamps 20 ms late, the estimate must come close to 20 ms
+// and give back most of the APE the lag costs.
 TEST(CliTimeOffset, AnExcitedDriveEstimatesTheLagAndRecoversTheTrajectory) {
   test::TempDir dir("cli_time_offset_slalom");
   const fs::path trajectory = fs::path(GVIO_TEST_CACHE_DIR) / "slalom_6mps_10s.tum";
