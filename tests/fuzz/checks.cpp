@@ -4,6 +4,7 @@
 #include <string>
 
 #include "fuzz/harness.hpp"
+#include "io/dataset_sources.hpp"
 
 namespace gvio::fuzz {
 
@@ -86,6 +87,23 @@ void checkDataset(const io::Dataset& ds) {
   checkFixes(ds.gnss);
   if (ds.imu_noise) checkImuNoise(*ds.imu_noise);
   if (ds.groundtruth) checkTrajectory(*ds.groundtruth, true);
+}
+
+void readWholeDataset(const std::filesystem::path& dataset,
+                      std::vector<std::filesystem::path> calib_files) {
+  io::DatasetSources sources;
+  sources.dataset = dataset;
+  sources.calib_files = std::move(calib_files);
+  const io::Dataset ds = io::openDataset(sources, io::ReaderConfig{});
+  checkDataset(ds);
+  for (std::size_t f = 0; f < ds.frames.size(); ++f) {
+    for (std::size_t c = 0; c < ds.cameras.size(); ++c) {
+      const cv::Mat image = io::loadFrameImage(ds, f, c);
+      require(image.type() == CV_8UC1 && image.cols == ds.cameras[c].width_px &&
+                  image.rows == ds.cameras[c].height_px,
+              "image not 8-bit grey of the camera's size");
+    }
+  }
 }
 
 }  // namespace gvio::fuzz

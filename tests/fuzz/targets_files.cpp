@@ -30,23 +30,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The whole dataset as `gvio run` opens it, and every frame's images as the run loads them.
-void readWholeDataset(const fs::path& dataset, std::vector<fs::path> calib_files = {}) {
-  io::DatasetSources sources;
-  sources.dataset = dataset;
-  sources.calib_files = std::move(calib_files);
-  const io::Dataset ds = io::openDataset(sources, io::ReaderConfig{});
-  checkDataset(ds);
-  for (std::size_t f = 0; f < ds.frames.size(); ++f) {
-    for (std::size_t c = 0; c < ds.cameras.size(); ++c) {
-      const cv::Mat image = io::loadFrameImage(ds, f, c);
-      require(image.type() == CV_8UC1 && image.cols == ds.cameras[c].width_px &&
-                  image.rows == ds.cameras[c].height_px,
-              "image not 8-bit grey of the camera's size");
-    }
-  }
-}
-
 // KITTI raw: 3 frames at 10 Hz, 10 Hz oxts, stereo 32x16, calibration beside the drive.
 constexpr const char* kKittiDrive = "2011_09_26/2011_09_26_drive_0001_sync";
 

@@ -12,7 +12,6 @@
 #include "fuzz/harness.hpp"
 #include "fuzz/targets_list.hpp"
 #include "io/dataset.hpp"
-#include "io/dataset_sources.hpp"
 #include "io/kalibr_writer.hpp"
 #include "io/ros2/ros2_bag_writer.hpp"
 #include "io/ros2/ros2_messages.hpp"
@@ -103,31 +102,11 @@ void prepareBags(const fs::path& dir) {
   test::writeText(dir / "imu.yaml", io::kalibrImuYaml(ImuNoise{}, 100.0, "/imu0"));
 }
 
-// The bag as `gvio run` opens it, every image loaded as the run loads it.
-void readBag(const fs::path& dataset, const fs::path& imu_yaml) {
-  io::DatasetSources sources;
-  sources.dataset = dataset;
-  sources.calib_files = {imu_yaml};
-  sources.require_calibration = false;
-  const io::Dataset ds = io::openDataset(sources, io::ReaderConfig{});
-  checkDataset(ds);
-  if (ds.cameras.empty() || ds.cameras.front().fx <= 0.0) return;
-  for (const CameraModel& c : ds.cameras) checkCamera(c);
-  for (std::size_t f = 0; f < ds.frames.size(); ++f) {
-    for (std::size_t c = 0; c < ds.cameras.size(); ++c) {
-      const cv::Mat image = io::loadFrameImage(ds, f, c);
-      require(image.type() == CV_8UC1 && image.cols == ds.cameras[c].width_px &&
-                  image.rows == ds.cameras[c].height_px,
-              "image not 8-bit grey of the camera's size");
-    }
-  }
-}
-
 Target bagTarget(std::string name, const std::string& folder, const std::string& file,
                  bool whole_folder) {
   return Target{std::move(name), folder + "/" + file, prepareBags,
                 [=](const fs::path& d) {
-                  readBag(whole_folder ? d / folder : d / folder / file, d / "imu.yaml");
+                  readWholeDataset(whole_folder ? d / folder : d / folder / file, {d / "imu.yaml"});
                 },
                 ""};
 }

@@ -43,6 +43,19 @@ void writeText(const fs::path& file, const std::string& text) {
   if (!out) throw std::runtime_error("cannot write fixture " + file.string());
 }
 
+std::vector<std::vector<double>> tumRows(const std::filesystem::path& file) {
+  std::vector<std::vector<double>> rows;
+  std::istringstream in(readText(file));
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    std::vector<double> row;
+    for (double v; fields >> v;) row.push_back(v);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
 std::string readText(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   std::stringstream ss;

@@ -22,6 +22,8 @@ class TempDir {
 };
 
 void writeText(const std::filesystem::path& file, const std::string& text);
+// A TUM file's rows of numbers (comment and empty lines skipped), to compare two runs' outputs.
+std::vector<std::vector<double>> tumRows(const std::filesystem::path& file);
 std::string readText(const std::filesystem::path& file);
 // Replaces line `line` (1-based) of a text file.
 void replaceLine(const std::filesystem::path& file, std::size_t line, const std::string& text);

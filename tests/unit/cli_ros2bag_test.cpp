@@ -16,21 +16,8 @@ namespace {
 using testing::HasSubstr;
 namespace fs = std::filesystem;
 
-std::vector<std::vector<double>> tumRows(const fs::path& file) {
-  std::vector<std::vector<double>> rows;
-  std::istringstream in(test::readText(file));
-  for (std::string line; std::getline(in, line);) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    std::vector<double> row;
-    for (double v; fields >> v;) row.push_back(v);
-    rows.push_back(row);
-  }
-  return rows;
-}
-
 double maxDifference(const fs::path& a_file, const fs::path& b_file) {
-  const auto a = tumRows(a_file), b = tumRows(b_file);
+  const auto a = test::tumRows(a_file), b = test::tumRows(b_file);
   EXPECT_EQ(a.size(), b.size()) << a_file << " vs " << b_file;
   EXPECT_GT(a.size(), 50U) << a_file;
   double worst = 0.0;

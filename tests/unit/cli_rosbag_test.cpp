@@ -15,19 +15,6 @@ namespace {
 using testing::HasSubstr;
 namespace fs = std::filesystem;
 
-std::vector<std::vector<double>> tumRows(const fs::path& file) {
-  std::vector<std::vector<double>> rows;
-  std::istringstream in(test::readText(file));
-  for (std::string line; std::getline(in, line);) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    std::vector<double> row;
-    for (double v; fields >> v;) row.push_back(v);
-    rows.push_back(row);
-  }
-  return rows;
-}
-
 TEST(CliRosbag, TheBagAndTheFolderOfOneSeedGiveTheSameRun) {
   const std::string drive =
       fmt::format("--trajectory {}/assets/demo/drive.tum --seconds 8 --seed 4", GVIO_SOURCE_DIR);
@@ -47,7 +34,8 @@ TEST(CliRosbag, TheBagAndTheFolderOfOneSeedGiveTheSameRun) {
   const test::CommandResult from_folder = run(folder, "folder");
   ASSERT_EQ(from_folder.exit_code, 0) << from_folder.err;
   for (const char* file : {"trajectory_vio.tum", "trajectory.tum"}) {
-    const auto a = tumRows(dir.path() / "bag" / file), b = tumRows(dir.path() / "folder" / file);
+    const auto a = test::tumRows(dir.path() / "bag" / file),
+               b = test::tumRows(dir.path() / "folder" / file);
     ASSERT_EQ(a.size(), b.size()) << file;
     ASSERT_GT(a.size(), 50U) << file;
     for (std::size_t i = 0; i < a.size(); ++i) {
