@@ -266,7 +266,14 @@ void applyBagCalibration(const Ros2Bag& bag, Dataset& ds) {
   const std::string imu_frame =
       imu_topic.empty() ? std::string() : tfFrame(firstFrameId(bag, imu_topic));
   if (!ds.cameras.empty()) {
-    CameraCalibration calibration = calibrateCameras(bag, ds, tree, imu_frame);
+    CameraCalibration calibration;
+    try {
+      calibration = calibrateCameras(bag, ds, tree, imu_frame);
+    } catch (const Ros2Error& e) {
+      // A CameraInfo that contradicts its images or names a model gvio cannot use leaves the
+      // cameras uncalibrated, saying why: Kalibr files (--calib) can still calibrate them.
+      calibration.missing = e.what();
+    }
     if (!imu_topic.empty() && imu_frame.empty()) {
       // Without the IMU's frame the body frame is unknown: no camera may be placed in it.
       calibration.missing =

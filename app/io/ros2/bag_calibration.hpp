@@ -17,10 +17,11 @@
 namespace gvio::io::ros2 {
 
 // Sets ds.cameras' intrinsics and T_b_c when the bag calibrates every camera (else leaves them
-// uncalibrated and says why in ds.calibration_missing), ds.gnss_lever_arm_b, and
-// ds.calibration_sources. ds.bag_topics names the topics of each role. Throws Ros2Error for a
-// CameraInfo that contradicts its images (size, binning, region of interest) or names an
-// unsupported distortion model.
+// uncalibrated and says why in ds.calibration_missing: no CameraInfo, no tf path, a CameraInfo
+// that contradicts its images (size, binning, region of interest) or names an unsupported
+// distortion model), ds.gnss_lever_arm_b, and ds.calibration_sources. ds.bag_topics names the
+// topics of each role. Throws Ros2Error for a message that cannot be decoded or a transform that
+// is not a rigid motion.
 void applyBagCalibration(const Ros2Bag& bag, Dataset& ds);
 
 }  // namespace gvio::io::ros2
