@@ -84,6 +84,10 @@ void InsConfig::validate() const {
   requirePositive(align.same_solution_deg, "fusion.ins.align_same_solution_deg");
   requirePositive(align.min_nll_gap, "fusion.ins.align_min_nll_gap");
   requirePositive(align.bank_max_heading_sigma_deg, "fusion.ins.align_bank_max_heading_sigma_deg");
+  if (!(align.imu_orientation_max_sigma_deg >= 0.0 &&
+        align.imu_orientation_max_sigma_deg <= 90.0)) {
+    throw InvalidInput("config: fusion.ins.align_imu_orientation_max_sigma_deg must be in [0, 90]");
+  }
 }
 
 std::optional<Eigen::Vector2d> fixVelocityEn(const GnssFix& fix) {

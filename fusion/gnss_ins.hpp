@@ -30,6 +30,7 @@
 #include <variant>
 
 #include "fusion/geodesy.hpp"
+#include "fusion/imu_attitude.hpp"
 #include "fusion/ins_alignment.hpp"
 #include "fusion/ins_error_model.hpp"
 #include "fusion/ins_mount.hpp"
@@ -140,6 +141,9 @@ class GnssIns {
   // later than its stamp. Fixes are applied at the filter time of the last IMU sample (causal).
   void addImu(const ImuSample& sample);
   void addFix(const GnssFix& fix);
+  // An attitude the IMU reports, given before the first IMU sample later than its stamp: until
+  // the filter is initialised, the latest one can give the heading (fusion.ins.align_imu_*).
+  void addAttitude(const ImuAttitude& attitude);
   // Closes the last outage at the last IMU sample.
   void finish();
   // Starts the filter at `anchor` with this state and covariance instead of initialising it
@@ -170,6 +174,8 @@ class GnssIns {
   [[nodiscard]] bool tryCourseInitialize(const GnssFix& fix, const Eigen::Vector3d& p_ant_enu);
   void initializeFromAlignment(const AlignmentSolution& solution, const std::string& method);
   void startBank();  // the scouts, from the anchor, fed what pending_ holds
+  // The heading of the IMU's own attitude at the last sample, as the levelled frame's yaw.
+  [[nodiscard]] bool tryAttitudeHeading();
   // P at initialisation: the fix's position sigmas, the configured velocity, tilt and bias
   // sigmas, this heading sigma.
   void setInitialCovariance(const GnssFix& fix, double heading_sigma_rad);
@@ -198,7 +204,8 @@ class GnssIns {
   bool mount_known_ = false;  // the constraint may be applied
   MountEstimator mount_estimator_;
   std::optional<TrackAlignment> align_;
-  std::unique_ptr<HeadingBank> bank_;  // scouts over headings, while the alignment has none
+  std::unique_ptr<HeadingBank> bank_;    // scouts over headings, while the alignment has none
+  std::optional<ImuAttitude> attitude_;  // the IMU's latest reported attitude, before init
   std::vector<Event> pending_;  // since the alignment's anchor, replayed once it has a heading
   bool initialized_ = false;
   InsState x_;

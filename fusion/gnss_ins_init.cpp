@@ -80,6 +80,7 @@ void GnssIns::tryInitialize(const GnssFix& fix, const Eigen::Vector3d& p_ant) {
       initializeFromAlignment(*solution, "track");
       return;
     }
+    if (tryAttitudeHeading()) return;
     const double max_sigma = config_.align.bank_max_heading_sigma_deg * kDegToRad;
     if (const std::optional<HeadingChoice> choice =
             bank_ ? bank_->choose(max_sigma) : std::nullopt) {
@@ -94,6 +95,29 @@ void GnssIns::tryInitialize(const GnssFix& fix, const Eigen::Vector3d& p_ant) {
   }
   if (tryCourseInitialize(fix, p_ant)) return;
   if (!align_) recordBeforeInit(fix);  // else it waits in pending_
+}
+
+void GnssIns::addAttitude(const ImuAttitude& attitude) {
+  if (!initialized_) attitude_ = attitude;
+}
+
+bool GnssIns::tryAttitudeHeading() {
+  const double max_sigma = config_.align.imu_orientation_max_sigma_deg * kDegToRad;
+  // The attitude must be of now (within two IMU periods of the last sample): it is compared with
+  // the levelled frame's attitude now.
+  constexpr std::int64_t kMaxAgeNs = 50'000'000;
+  if (!attitude_ || !last_imu_ || max_sigma <= 0.0 || attitude_->yaw_sigma_rad > max_sigma ||
+      std::abs(attitude_->t_ns - last_imu_->t_ns) > kMaxAgeNs) {
+    return false;
+  }
+  // As for the heading bank's winner: the levelled frame's yaw is the reported attitude against
+  // the gyros' attitude integrated from the anchor.
+  const Eigen::Matrix3d R = attitude_->R_enu_b * align_->attitudeNow().transpose();
+  const double psi = std::atan2(R(1, 0), R(0, 0));
+  const auto solution = align_->solutionWithHeading(psi, attitude_->yaw_sigma_rad);
+  if (!solution) return false;
+  initializeFromAlignment(*solution, "imu orientation");
+  return true;
 }
 
 void GnssIns::startBank() {

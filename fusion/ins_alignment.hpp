@@ -52,6 +52,9 @@ struct AlignmentConfig {
   double same_solution_deg = 15.0;
   double min_nll_gap = 30.0;
   double bank_max_heading_sigma_deg = 15.0;  // the winner's own 1-sigma (the filter refines it)
+  // An attitude the IMU itself reports (sensor_msgs/Imu orientation, an AHRS) gives the heading
+  // when its stated yaw 1-sigma is at most this (0: never used).
+  double imu_orientation_max_sigma_deg = 10.0;
 };
 
 struct AlignmentSolution {

@@ -401,6 +401,8 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("fusion.ins.align_min_nll_gap", c.fusion.ins.align.min_nll_gap),
       number("fusion.ins.align_bank_max_heading_sigma_deg",
              c.fusion.ins.align.bank_max_heading_sigma_deg),
+      number("fusion.ins.align_imu_orientation_max_sigma_deg",
+             c.fusion.ins.align.imu_orientation_max_sigma_deg),
       boolean("map.enabled", c.map.enabled),
       integer("map.sparse.min_landmark_observations", m.sparse.min_landmark_observations),
       number("map.sparse.max_landmark_reprojection_px", m.sparse.max_landmark_reprojection_px),

@@ -2,9 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "fusion/gnss_screening.hpp"
 #include "io/input_error.hpp"
@@ -139,6 +142,21 @@ BagTopicUse topicUse(const std::vector<bag::TopicInfo>& topics, const std::strin
   return use;
 }
 
+// The attitude an Imu message reports, when its covariance says it is valid (Imu.msg: element 0
+// = -1 for none; an all-zero covariance is "unknown": no yaw sigma, not used) and the quaternion
+// is a rotation.
+std::optional<fusion::ImuAttitude> reportedAttitude(const bag::ImuMessage& m, std::int64_t t_ns) {
+  const auto& cov = m.orientation_covariance;
+  const auto& q = m.orientation_xyzw;
+  const Eigen::Quaterniond rotation(q[3], q[0], q[1], q[2]);
+  const double norm = rotation.norm();
+  if (cov[0] < 0.0 || !std::isfinite(cov[8]) || !(cov[8] > 0.0) || !std::isfinite(norm) ||
+      std::abs(norm - 1.0) > 1e-3) {
+    return std::nullopt;
+  }
+  return fusion::ImuAttitude{t_ns, rotation.normalized().toRotationMatrix(), std::sqrt(cov[8])};
+}
+
 void readImu(const fs::path& file, const BagSource& reader, const std::string& topic, Dataset& ds) {
   const std::vector<bag::ImuMessage> messages = reader.readImu(topic);
   BagTopicUse& use = ds.bag_topics.back();
@@ -153,6 +171,7 @@ void readImu(const fs::path& file, const BagSource& reader, const std::string& t
                        fmt::format("topic {}: message {} holds a non-finite value", topic, i));
     }
     ds.imu.push_back(s);
+    if (const auto attitude = reportedAttitude(m, t_ns)) ds.imu_attitude.push_back(*attitude);
   }
   use.used = ds.imu.size();
 }

@@ -11,6 +11,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "fusion/geodesy.hpp"
+#include "fusion/imu_attitude.hpp"
 #include "io/reader_config.hpp"
 #include "odometry/measurements.hpp"
 #include "odometry/trajectory.hpp"
@@ -65,6 +66,9 @@ struct Dataset {
   std::vector<CameraModel> cameras;
   std::vector<FrameRecord> frames;
   std::vector<ImuSample> imu;
+  // Attitudes the IMU itself reported (a bag's sensor_msgs/Imu orientation whose covariance
+  // states a yaw sigma), in the IMU's clock: GNSS/INS may take its heading from them.
+  std::vector<fusion::ImuAttitude> imu_attitude;
   std::optional<ImuNoise> imu_noise;  // when the dataset states it
   std::vector<GnssFix> gnss;
   std::string gnss_source;  // file the fixes came from, empty without GNSS

@@ -111,12 +111,16 @@ InsRunResult runGnssIns(const io::Dataset& ds, const fusion::InsConfig& config,
                  ? *ds.groundtruth_enu_origin
                  : fusion::Lla{first.lat_deg, first.lon_deg, first.h_ellipsoid_m};
   fusion::GnssIns ins(config, fusion::EnuFrame(r.origin));
-  std::size_t f = 0;
+  std::size_t f = 0, a = 0;
   for (const ImuSample& s : ds.imu) {
     while (f < screened.fixes.size() && screened.fixes[f].t_ns <= s.t_ns) {
       ins.addFix(screened.fixes[f++]);
     }
     ins.addImu(s);
+    // The IMU's own attitudes (an AHRS's orientation in its messages), with their samples.
+    while (a < ds.imu_attitude.size() && ds.imu_attitude[a].t_ns <= s.t_ns) {
+      ins.addAttitude(ds.imu_attitude[a++]);
+    }
   }
   ins.finish();
   r.stats = ins.stats();

@@ -101,7 +101,6 @@ void Ros2BagOutput::writeSensorsUpTo(std::int64_t t_ns) {
     ros2::Ros2Imu m;
     m.imu = bagImuMessage(imu_[next_imu_]);
     m.frame_id = kImuFrame;
-    m.orientation_covariance[0] = -1.0;  // Imu.msg: no orientation estimate
     writer_->write(topics_.imu, m.imu.t.header_ns, ros2::encodeImu(m));
   }
   for (; next_fix_ < fixes_.size() && fixes_[next_fix_].t_ns <= t_ns; ++next_fix_) {

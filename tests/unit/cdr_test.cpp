@@ -73,8 +73,8 @@ Ros2Imu sampleImu(const std::string& frame) {
   m.imu.t.header_ns = -1'700'000'000;  // {sec: -2, nanosec: 3e8}
   m.imu.acc_mps2 = {0.1, -9.81, std::numeric_limits<double>::infinity()};
   m.imu.gyr_radps = {std::bit_cast<double>(kNanPayload), -0.0, 1e-300};
-  m.orientation_xyzw = {0.5, -0.5, 0.5, -0.5};
-  m.orientation_covariance[0] = -1.0;
+  m.imu.orientation_xyzw = {0.5, -0.5, 0.5, -0.5};
+  m.imu.orientation_covariance[0] = -1.0;
   m.angular_velocity_covariance[4] = 1e-6;
   m.linear_acceleration_covariance[8] = std::numeric_limits<double>::denorm_min();
   m.frame_id = frame;
@@ -258,7 +258,7 @@ TEST(CdrGolden, ImuLittleEndian) {
   Ros2Imu m;
   m.imu.t.header_ns = 10'500'000'000;
   m.frame_id = "imu0";
-  m.orientation_covariance[0] = -1.0;
+  m.imu.orientation_covariance[0] = -1.0;
   m.imu.gyr_radps = {0.25, 0.0, -0.5};
   m.imu.acc_mps2 = {0.0, 2.0, std::bit_cast<double>(kNanPayload)};
   m.linear_acceleration_covariance = {0.25, 0, 0, 0, 0.25, 0, 0, 0, 0.25};
@@ -267,8 +267,8 @@ TEST(CdrGolden, ImuLittleEndian) {
   const Ros2Imu back = decodeImu(expected);
   EXPECT_EQ(back.imu.t.header_ns, 10'500'000'000);
   EXPECT_EQ(back.frame_id, "imu0");
-  EXPECT_EQ(back.orientation_xyzw, (std::array<double, 4>{0, 0, 0, 1}));
-  EXPECT_EQ(back.orientation_covariance[0], -1.0);
+  EXPECT_EQ(back.imu.orientation_xyzw, (std::array<double, 4>{0, 0, 0, 1}));
+  EXPECT_EQ(back.imu.orientation_covariance[0], -1.0);
   EXPECT_EQ(back.imu.gyr_radps, m.imu.gyr_radps);
   EXPECT_EQ(bits(back.imu.acc_mps2[2]), kNanPayload);
   EXPECT_EQ(back.linear_acceleration_covariance, m.linear_acceleration_covariance);

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <zstd.h>
 
+#include <Eigen/Geometry>
+#include <array>
 #include <fstream>
 
 #include "io/input_error.hpp"
@@ -156,6 +158,43 @@ TEST(Ros2Bag, RefusesWhatIsNotABag) {
     FAIL();
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("not a ROS 2 bag"));
+  }
+}
+
+// The attitude an Imu message reports is kept when its covariance states a yaw sigma (Imu.msg:
+// element 0 = -1 means none; all zeros, "unknown", is no sigma either).
+TEST(Ros2Bag, ImuOrientationWithAStatedYawSigmaIsKept) {
+  test::TempDir dir("ros2_bag_attitude");
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
+  const std::array<std::array<double, 9>, 3> covariances = {
+      std::array<double, 9>{0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.0025}, std::array<double, 9>{-1.0},
+      std::array<double, 9>{}};
+  for (std::size_t k = 0; k < covariances.size(); ++k) {
+    const fs::path folder = dir.path() / std::to_string(k);
+    fs::create_directories(folder);
+    {
+      Ros2BagWriter writer(folder, "drive", Ros2Storage::kMcap, "none");
+      const std::size_t imu = writer.addTopic("/imu", kRos2ImuType);
+      for (int i = 0; i < 5; ++i) {
+        Ros2Imu m;
+        m.imu.t.header_ns = 1'000'000'000 + i * 10'000'000LL;
+        m.imu.acc_mps2 = {0.0, 0.0, 9.81};
+        m.imu.orientation_xyzw = {q.x(), q.y(), q.z(), q.w()};
+        m.imu.orientation_covariance = covariances[k];
+        writer.write(imu, m.imu.t.header_ns, encodeImu(m));
+      }
+      writer.close();
+    }
+    const Dataset ds = readRos2Bag(folder, ReaderConfig{});
+    ASSERT_EQ(ds.imu.size(), 5U);
+    if (k > 0) {
+      EXPECT_TRUE(ds.imu_attitude.empty()) << k;
+      continue;
+    }
+    ASSERT_EQ(ds.imu_attitude.size(), 5U);
+    EXPECT_EQ(ds.imu_attitude[2].t_ns, ds.imu[2].t_ns);
+    EXPECT_DOUBLE_EQ(ds.imu_attitude[2].yaw_sigma_rad, 0.05);
+    EXPECT_LT((ds.imu_attitude[2].R_enu_b - q.toRotationMatrix()).norm(), 1e-12);
   }
 }
 

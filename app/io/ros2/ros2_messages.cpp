@@ -112,8 +112,8 @@ Ros2Imu decodeImu(std::span<const std::uint8_t> message) {
   CdrReader in(message, kRos2ImuType);
   Ros2Imu out;
   out.imu.t.header_ns = readHeader(in, out.frame_id);
-  out.orientation_xyzw = in.f64Array<4>("orientation");
-  out.orientation_covariance = in.f64Array<9>("orientation_covariance");
+  out.imu.orientation_xyzw = in.f64Array<4>("orientation");
+  out.imu.orientation_covariance = in.f64Array<9>("orientation_covariance");
   out.imu.gyr_radps = in.f64Array<3>("angular_velocity");
   out.angular_velocity_covariance = in.f64Array<9>("angular_velocity_covariance");
   out.imu.acc_mps2 = in.f64Array<3>("linear_acceleration");
@@ -125,8 +125,8 @@ Ros2Imu decodeImu(std::span<const std::uint8_t> message) {
 std::vector<std::uint8_t> encodeImu(const Ros2Imu& message) {
   CdrWriter out;
   writeHeader(out, message.imu.t.header_ns, message.frame_id);
-  out.f64s(message.orientation_xyzw);
-  out.f64s(message.orientation_covariance);
+  out.f64s(message.imu.orientation_xyzw);
+  out.f64s(message.imu.orientation_covariance);
   out.f64s(message.imu.gyr_radps);
   out.f64s(message.angular_velocity_covariance);
   out.f64s(message.imu.acc_mps2);

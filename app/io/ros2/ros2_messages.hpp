@@ -34,11 +34,10 @@ inline constexpr const char* kRos2NavSatFixType = "sensor_msgs/msg/NavSatFix";
 inline constexpr const char* kRos2CameraInfoType = "sensor_msgs/msg/CameraInfo";
 inline constexpr const char* kRos2TfType = "tf2_msgs/msg/TFMessage";
 
-// sensor_msgs/msg/Imu: imu.gyr_radps is angular_velocity, imu.acc_mps2 linear_acceleration.
+// sensor_msgs/msg/Imu: imu.gyr_radps is angular_velocity, imu.acc_mps2 linear_acceleration,
+// imu.orientation_* the orientation and its covariance.
 struct Ros2Imu {
   bag::ImuMessage imu;
-  std::array<double, 4> orientation_xyzw{0.0, 0.0, 0.0, 1.0};
-  std::array<double, 9> orientation_covariance{};  // [0] = -1: no orientation (Imu.msg)
   std::array<double, 9> angular_velocity_covariance{};
   std::array<double, 9> linear_acceleration_covariance{};
   std::string frame_id;

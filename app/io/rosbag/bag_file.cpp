@@ -189,6 +189,10 @@ std::vector<ImuMessage> BagReader::readImu(const std::string& topic) const {
         out.acc_mps2 = {msg.linear_acceleration.x, msg.linear_acceleration.y,
                         msg.linear_acceleration.z};
         out.gyr_radps = {msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z};
+        out.orientation_xyzw = {msg.orientation.x, msg.orientation.y, msg.orientation.z,
+                                msg.orientation.w};
+        for (std::size_t i = 0; i < 9; ++i)
+          out.orientation_covariance[i] = msg.orientation_covariance[i];
         return out;
       });
 }
@@ -294,7 +298,12 @@ void BagWriter::write(const std::string& topic, const ImuMessage& message) {
   msg.angular_velocity.x = message.gyr_radps[0];
   msg.angular_velocity.y = message.gyr_radps[1];
   msg.angular_velocity.z = message.gyr_radps[2];
-  msg.orientation_covariance[0] = -1.0;  // REP 145: no orientation estimate
+  msg.orientation.x = message.orientation_xyzw[0];
+  msg.orientation.y = message.orientation_xyzw[1];
+  msg.orientation.z = message.orientation_xyzw[2];
+  msg.orientation.w = message.orientation_xyzw[3];
+  for (std::size_t i = 0; i < 9; ++i)
+    msg.orientation_covariance[i] = message.orientation_covariance[i];
   guarded("writing " + topic, [&] { impl_->bag.write(topic, rosTime(message.t.receive_ns), msg); });
 }
 

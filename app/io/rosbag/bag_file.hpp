@@ -35,6 +35,10 @@ struct ImuMessage {
   Stamps t;
   std::array<double, 3> acc_mps2{};
   std::array<double, 3> gyr_radps{};
+  // The attitude the IMU reports (REP 145: the body's rotation from ENU) and its covariance
+  // (row major, rad^2, about x y z); element 0 = -1: no orientation (sensor_msgs/Imu).
+  std::array<double, 4> orientation_xyzw{0.0, 0.0, 0.0, 1.0};
+  std::array<double, 9> orientation_covariance{-1.0};
 };
 
 // sensor_msgs/NavSatFix: status -1 no fix, 0 fix, 1 SBAS, 2 GBAS; altitude above the WGS84
