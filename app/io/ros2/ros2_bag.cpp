@@ -29,8 +29,9 @@ std::vector<fs::path> storageFilesOf(const fs::path& folder) {
     const std::string stem = p.stem().string();
     const std::size_t us = stem.find_last_of('_');
     const std::string digits = us == std::string::npos ? "" : stem.substr(us + 1);
-    const bool numeric = !digits.empty() && digits.size() < 9 &&
-                         std::all_of(digits.begin(), digits.end(), ::isdigit);
+    const bool numeric =
+        !digits.empty() && digits.size() < 9 &&
+        std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; });
     return std::make_pair(numeric ? stem.substr(0, us) : stem, numeric ? std::stoi(digits) : -1);
   };
   std::sort(files.begin(), files.end(), [&](const fs::path& a, const fs::path& b) {
