@@ -176,6 +176,10 @@ class GnssIns {
   void startBank();  // the scouts, from the anchor, fed what pending_ holds
   // The heading of the IMU's own attitude at the last sample, as the levelled frame's yaw.
   [[nodiscard]] bool tryAttitudeHeading();
+  // Initialises from the alignment with the heading an attitude of now gives (the heading bank's
+  // winner, the IMU's own); false when the alignment has no solution with it.
+  [[nodiscard]] bool initializeFromAttitudeNow(const Eigen::Matrix3d& R_enu_b,
+                                               double heading_sigma_rad, const std::string& method);
   // P at initialisation: the fix's position sigmas, the configured velocity, tilt and bias
   // sigmas, this heading sigma.
   void setInitialCovariance(const GnssFix& fix, double heading_sigma_rad);

@@ -82,15 +82,9 @@ void GnssIns::tryInitialize(const GnssFix& fix, const Eigen::Vector3d& p_ant) {
     }
     if (tryAttitudeHeading()) return;
     const double max_sigma = config_.align.bank_max_heading_sigma_deg * kDegToRad;
-    if (const std::optional<HeadingChoice> choice =
-            bank_ ? bank_->choose(max_sigma) : std::nullopt) {
-      // The levelled frame's yaw: the winner's attitude now against the gyros' from the anchor.
-      const Eigen::Matrix3d R = choice->R_enu_b * align_->attitudeNow().transpose();
-      const double psi = std::atan2(R(1, 0), R(0, 0));
-      if (const auto solution = align_->solutionWithHeading(psi, choice->sigma_rad)) {
-        initializeFromAlignment(*solution, "heading bank");
-        return;
-      }
+    const std::optional<HeadingChoice> choice = bank_ ? bank_->choose(max_sigma) : std::nullopt;
+    if (choice && initializeFromAttitudeNow(choice->R_enu_b, choice->sigma_rad, "heading bank")) {
+      return;
     }
   }
   if (tryCourseInitialize(fix, p_ant)) return;
@@ -103,20 +97,24 @@ void GnssIns::addAttitude(const ImuAttitude& attitude) {
 
 bool GnssIns::tryAttitudeHeading() {
   const double max_sigma = config_.align.imu_orientation_max_sigma_deg * kDegToRad;
-  // The attitude must be of now (within two IMU periods of the last sample): it is compared with
-  // the levelled frame's attitude now.
+  // The attitude must be of now (within 50 ms of the last sample): it is compared with the
+  // levelled frame's attitude now.
   constexpr std::int64_t kMaxAgeNs = 50'000'000;
   if (!attitude_ || !last_imu_ || max_sigma <= 0.0 || attitude_->yaw_sigma_rad > max_sigma ||
       std::abs(attitude_->t_ns - last_imu_->t_ns) > kMaxAgeNs) {
     return false;
   }
-  // As for the heading bank's winner: the levelled frame's yaw is the reported attitude against
-  // the gyros' attitude integrated from the anchor.
-  const Eigen::Matrix3d R = attitude_->R_enu_b * align_->attitudeNow().transpose();
+  return initializeFromAttitudeNow(attitude_->R_enu_b, attitude_->yaw_sigma_rad, "imu orientation");
+}
+
+bool GnssIns::initializeFromAttitudeNow(const Eigen::Matrix3d& R_enu_b, double heading_sigma_rad,
+                                        const std::string& method) {
+  // The levelled frame's yaw: the attitude now against the gyros' integrated from the anchor.
+  const Eigen::Matrix3d R = R_enu_b * align_->attitudeNow().transpose();
   const double psi = std::atan2(R(1, 0), R(0, 0));
-  const auto solution = align_->solutionWithHeading(psi, attitude_->yaw_sigma_rad);
+  const auto solution = align_->solutionWithHeading(psi, heading_sigma_rad);
   if (!solution) return false;
-  initializeFromAlignment(*solution, "imu orientation");
+  initializeFromAlignment(*solution, method);
   return true;
 }
 

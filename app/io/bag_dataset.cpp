@@ -147,14 +147,9 @@ BagTopicUse topicUse(const std::vector<bag::TopicInfo>& topics, const std::strin
 // is a rotation.
 std::optional<fusion::ImuAttitude> reportedAttitude(const bag::ImuMessage& m, std::int64_t t_ns) {
   const auto& cov = m.orientation_covariance;
-  const auto& q = m.orientation_xyzw;
-  const Eigen::Quaterniond rotation(q[3], q[0], q[1], q[2]);
-  const double norm = rotation.norm();
-  if (cov[0] < 0.0 || !std::isfinite(cov[8]) || !(cov[8] > 0.0) || !std::isfinite(norm) ||
-      std::abs(norm - 1.0) > 1e-3) {
-    return std::nullopt;
-  }
-  return fusion::ImuAttitude{t_ns, rotation.normalized().toRotationMatrix(), std::sqrt(cov[8])};
+  const std::optional<Eigen::Matrix3d> R = messageRotation(m.orientation_xyzw);
+  if (cov[0] < 0.0 || !std::isfinite(cov[8]) || !(cov[8] > 0.0) || !R) return std::nullopt;
+  return fusion::ImuAttitude{t_ns, *R, std::sqrt(cov[8])};
 }
 
 void readImu(const fs::path& file, const BagSource& reader, const std::string& topic, Dataset& ds) {
@@ -321,6 +316,13 @@ void readFrames(const fs::path& file, const std::shared_ptr<const BagSource>& re
 }
 
 }  // namespace
+
+std::optional<Eigen::Matrix3d> messageRotation(const std::array<double, 4>& xyzw) {
+  const Eigen::Quaterniond q(xyzw[3], xyzw[0], xyzw[1], xyzw[2]);
+  const double norm = q.norm();
+  if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3) return std::nullopt;
+  return q.normalized().toRotationMatrix();
+}
 
 void readBagDataset(const fs::path& file, const std::shared_ptr<const BagSource>& source,
                     const ReaderConfig& config, Dataset& ds) {

@@ -20,18 +20,6 @@ using ros2::Ros2Topic;
 // A ROS 2 bag's messages decoded from CDR into what the bag dataset reader takes; the receive
 // time is the bag's log time.
 class Ros2Source final : public BagSource {
- private:
-  // Message i of t decoded by `decode`, a defect named with the topic and message.
-  template <typename Decode>
-  auto decoded(const Ros2Topic& t, std::size_t i, Decode decode) const {
-    try {
-      const std::vector<std::uint8_t> bytes = bag_->read(t, i);
-      return decode(std::span<const std::uint8_t>(bytes));
-    } catch (const Ros2Error& e) {
-      throw Ros2Error(fmt::format("topic {}: message {}: {}", t.name, i, e.what()));
-    }
-  }
-
  public:
   explicit Ros2Source(std::shared_ptr<const Ros2Bag> bag) : bag_(std::move(bag)) {}
 
@@ -47,7 +35,8 @@ class Ros2Source final : public BagSource {
     const Ros2Topic& t = topic(name, ros2::kRos2ImuType);
     std::vector<bag::ImuMessage> out;
     for (std::size_t i = 0; i < t.messages.size(); ++i) {
-      out.push_back(decoded(t, i, [](const auto& bytes) { return ros2::decodeImu(bytes).imu; }));
+      out.push_back(ros2::decodeMessage(
+          *bag_, t, i, [](const auto& bytes) { return ros2::decodeImu(bytes).imu; }));
       out.back().t.receive_ns = bag_->logTimeNs(t, i);
     }
     return out;
@@ -57,8 +46,8 @@ class Ros2Source final : public BagSource {
     const Ros2Topic& t = topic(name, ros2::kRos2NavSatFixType);
     std::vector<bag::NavSatFixMessage> out;
     for (std::size_t i = 0; i < t.messages.size(); ++i) {
-      out.push_back(
-          decoded(t, i, [](const auto& bytes) { return ros2::decodeNavSatFix(bytes).fix; }));
+      out.push_back(ros2::decodeMessage(
+          *bag_, t, i, [](const auto& bytes) { return ros2::decodeNavSatFix(bytes).fix; }));
       out.back().t.receive_ns = bag_->logTimeNs(t, i);
     }
     return out;
@@ -81,7 +70,7 @@ class Ros2Source final : public BagSource {
   bag::ImageMessage readImage(const std::string& name, std::size_t index) const override {
     const Ros2Topic& t = imageTopic(name);
     const bool compressed = t.type == ros2::kRos2CompressedImageType;
-    bag::ImageMessage m = decoded(t, index, [&](const auto& bytes) {
+    bag::ImageMessage m = ros2::decodeMessage(*bag_, t, index, [&](const auto& bytes) {
       return compressed ? ros2::decodeCompressedImage(bytes).image : ros2::decodeImage(bytes).image;
     });
     m.t.receive_ns = bag_->logTimeNs(t, index);

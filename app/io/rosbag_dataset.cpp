@@ -1,11 +1,10 @@
 #include "io/rosbag_dataset.hpp"
 
-#include <fstream>
-
 #include "io/bag_dataset.hpp"
 #include "io/bag_source.hpp"
 #include "io/input_error.hpp"
 #include "io/rosbag/bag_file.hpp"
+#include "io/text.hpp"
 
 namespace gvio::io {
 namespace {
@@ -36,10 +35,7 @@ class Ros1Source final : public BagSource {
 }  // namespace
 
 bool looksLikeRosbag(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  char magic[9] = {};
-  in.read(magic, sizeof magic);
-  return in.gcount() == sizeof magic && std::string(magic, sizeof magic) == "#ROSBAG V";
+  return fileStartsWith(file, "#ROSBAG V");
 }
 
 Dataset readRosbag(const fs::path& file, const ReaderConfig& config) {

@@ -62,6 +62,13 @@ void LineReader::fail(const std::string& message) const {
   throw InputError(path_, line_number_, message);
 }
 
+bool fileStartsWith(const std::filesystem::path& file, std::string_view prefix) {
+  std::ifstream in(file, std::ios::binary);
+  std::string head(prefix.size(), '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  return in.gcount() == static_cast<std::streamsize>(head.size()) && head == prefix;
+}
+
 std::string_view trim(std::string_view s) {
   const auto first = s.find_first_not_of(" \t");
   if (first == std::string_view::npos) return {};

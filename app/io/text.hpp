@@ -30,6 +30,10 @@ class LineReader {
 };
 
 std::string_view trim(std::string_view s);
+
+// True when the file's first bytes are `prefix` (format detection by magic number); false for a
+// file that cannot be read or is shorter.
+bool fileStartsWith(const std::filesystem::path& file, std::string_view prefix);
 bool isBlankOrComment(std::string_view line, char comment = '#');
 
 // Splits on a single delimiter character, trimming each field.

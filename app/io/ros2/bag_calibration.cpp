@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "io/bag_dataset.hpp"
 #include "io/ros2/ros2_error.hpp"
 #include "io/ros2/ros2_messages.hpp"
 #include "io/ros2/tf_tree.hpp"
@@ -11,30 +12,19 @@
 namespace gvio::io::ros2 {
 namespace {
 
-// Message i of a topic decoded (a defect named with the topic).
-template <typename Decode>
-auto decodedMessage(const Ros2Bag& bag, const Ros2Topic& topic, std::size_t i, Decode decode) {
-  try {
-    const std::vector<std::uint8_t> bytes = bag.read(topic, i);
-    return decode(std::span<const std::uint8_t>(bytes));
-  } catch (const Ros2Error& e) {
-    throw Ros2Error(fmt::format("topic {}: message {}: {}", topic.name, i, e.what()));
-  }
-}
-
 Eigen::Isometry3d isometry(const TransformMessage& m, const std::string& topic) {
-  const auto& q = m.rotation_xyzw;
-  const Eigen::Quaterniond rotation(q[3], q[0], q[1], q[2]);
+  const std::optional<Eigen::Matrix3d> R = messageRotation(m.rotation_xyzw);
   const Eigen::Vector3d t(m.translation[0], m.translation[1], m.translation[2]);
-  const double norm = rotation.norm();
-  if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3 || !t.allFinite()) {
+  if (!R || !t.allFinite()) {
+    const auto& q = m.rotation_xyzw;
     throw Ros2Error(
         fmt::format("{}: the transform {} -> {} is not a rigid motion (quaternion "
                     "norm {}, translation finite: {})",
-                    topic, m.frame_id, m.child_frame_id, norm, t.allFinite()));
+                    topic, m.frame_id, m.child_frame_id,
+                    Eigen::Quaterniond(q[3], q[0], q[1], q[2]).norm(), t.allFinite()));
   }
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = rotation.normalized().toRotationMatrix();
+  T.linear() = *R;
   T.translation() = t;
   return T;
 }
@@ -53,7 +43,7 @@ TfTree staticTree(const Ros2Bag& bag, std::vector<std::string>& warnings) {
     std::vector<TfLink> links;
     std::vector<bool> moves;
     for (std::size_t i = 0; i < topic.messages.size(); ++i) {
-      for (const TransformMessage& m : decodedMessage(bag, topic, i, decodeTfMessage)) {
+      for (const TransformMessage& m : decodeMessage(bag, topic, i, decodeTfMessage)) {
         TfLink link{tfFrame(m.frame_id), tfFrame(m.child_frame_id), isometry(m, topic.name),
                     topic.name};
         std::size_t k = 0;
@@ -173,11 +163,11 @@ namespace {
 std::string firstFrameId(const Ros2Bag& bag, const std::string& name) {
   const Ros2Topic* t = bag.topic(name);
   if (t == nullptr || t->messages.empty()) return {};
-  if (t->type == kRos2ImuType) return decodedMessage(bag, *t, 0, decodeImu).frame_id;
-  if (t->type == kRos2NavSatFixType) return decodedMessage(bag, *t, 0, decodeNavSatFix).frame_id;
-  if (t->type == kRos2ImageType) return decodedMessage(bag, *t, 0, decodeImage).frame_id;
+  if (t->type == kRos2ImuType) return decodeMessage(bag, *t, 0, decodeImu).frame_id;
+  if (t->type == kRos2NavSatFixType) return decodeMessage(bag, *t, 0, decodeNavSatFix).frame_id;
+  if (t->type == kRos2ImageType) return decodeMessage(bag, *t, 0, decodeImage).frame_id;
   if (t->type == kRos2CompressedImageType) {
-    return decodedMessage(bag, *t, 0, decodeCompressedImage).frame_id;
+    return decodeMessage(bag, *t, 0, decodeCompressedImage).frame_id;
   }
   return {};
 }
@@ -212,7 +202,7 @@ CameraCalibration calibrateCameras(const Ros2Bag& bag, const Dataset& ds, const 
       out.missing = fmt::format("no CameraInfo on {} beside {}", info_topic, image_topic);
       return out;
     }
-    infos.push_back(decodedMessage(bag, *t, 0, decodeCameraInfo));
+    infos.push_back(decodeMessage(bag, *t, 0, decodeCameraInfo));
     const bool rectified = isRectifiedTopic(image_topic);
     CameraModel& cam = out.cameras[c];
     setIntrinsics(infos.back(), rectified, info_topic, cam);

@@ -7,6 +7,7 @@
 
 #include "io/input_error.hpp"
 #include "io/ros2/bag_metadata.hpp"
+#include "io/ros2/mcap_records.hpp"
 #include "io/ros2/ros2_error.hpp"
 #include "io/ros2/ros2_messages.hpp"
 
@@ -40,20 +41,15 @@ std::vector<fs::path> storageFilesOf(const fs::path& folder) {
   return files;
 }
 
-// A zstd frame (rosbag2's per-message compression) expanded, its stated size checked first.
+// A zstd frame (rosbag2's per-message compression) expanded. The frame states its size
+// (rosbag2's compressor writes it); MCAP's chunk decompressor bounds that claim (1 GiB, zstd's
+// greatest ratio) before it allocates and checks the output against it.
 std::vector<std::uint8_t> zstdExpanded(const std::vector<std::uint8_t>& frame) {
   const unsigned long long size = ZSTD_getFrameContentSize(frame.data(), frame.size());
-  // A frame states its size (rosbag2's compressor does); 1 GiB bounds a hostile statement.
-  if (size == ZSTD_CONTENTSIZE_ERROR || size == ZSTD_CONTENTSIZE_UNKNOWN || size > (1ULL << 30)) {
+  if (size == ZSTD_CONTENTSIZE_ERROR || size == ZSTD_CONTENTSIZE_UNKNOWN) {
     throw Ros2Error("a zstd-compressed message without a valid stated size");
   }
-  std::vector<std::uint8_t> out(static_cast<std::size_t>(size));
-  const std::size_t got = ZSTD_decompress(out.data(), out.size(), frame.data(), frame.size());
-  if (ZSTD_isError(got) || got != out.size()) {
-    throw Ros2Error(std::string("a zstd-compressed message does not decompress: ") +
-                    (ZSTD_isError(got) ? ZSTD_getErrorName(got) : "short output"));
-  }
-  return out;
+  return mcap::decompress("zstd", frame, size, 0, "a zstd-compressed message");
 }
 
 }  // namespace

@@ -7,9 +7,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "io/ros2/ros2_error.hpp"
 #include "io/ros2/storage.hpp"
 
 namespace gvio::io::ros2 {
@@ -55,6 +57,18 @@ class Ros2Bag {
   std::string storage_;
   bool message_compression_ = false;  // zstd per message
 };
+
+// Message `index` of `topic` decoded by `decode` (a function of the message's bytes); a defect is
+// a Ros2Error naming the topic and the message.
+template <typename Decode>
+auto decodeMessage(const Ros2Bag& bag, const Ros2Topic& topic, std::size_t index, Decode decode) {
+  try {
+    const std::vector<std::uint8_t> bytes = bag.read(topic, index);
+    return decode(std::span<const std::uint8_t>(bytes));
+  } catch (const Ros2Error& e) {
+    throw Ros2Error("topic " + topic.name + ": message " + std::to_string(index) + ": " + e.what());
+  }
+}
 
 // A bag folder with metadata.yaml, or a file with MCAP's magic or SQLite's header.
 bool looksLikeRos2Bag(const std::filesystem::path& path);

@@ -3,25 +3,17 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cstring>
-#include <fstream>
 #include <limits>
 
 #include "io/ros2/mcap_reader.hpp"
+#include "io/ros2/mcap_records.hpp"
 #include "io/ros2/ros2_error.hpp"
 #include "io/ros2/sqlite_storage.hpp"
+#include "io/text.hpp"
 
 namespace gvio::io::ros2 {
 namespace {
 namespace fs = std::filesystem;
-
-bool startsWith(const fs::path& file, const char* magic, std::size_t size) {
-  std::ifstream in(file, std::ios::binary);
-  std::string head(size, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(size));
-  return in.gcount() == static_cast<std::streamsize>(size) &&
-         std::memcmp(head.data(), magic, size) == 0;
-}
 
 // An MCAP file's channels as topics (the schema name is the ROS 2 type, the channel's message
 // encoding its serialisation), its messages with their log times.
@@ -75,11 +67,12 @@ class McapStorage final : public StorageFile {
 }  // namespace
 
 bool looksLikeMcap(const fs::path& file) {
-  return startsWith(file, "\x89MCAP0\r\n", 8);
+  return fileStartsWith(file, std::string_view(reinterpret_cast<const char*>(mcap::kMagic.data()),
+                                               mcap::kMagic.size()));
 }
 
 bool looksLikeSqlite(const fs::path& file) {
-  return startsWith(file, "SQLite format 3", 16);
+  return fileStartsWith(file, std::string_view("SQLite format 3", 16));  // with its NUL
 }
 
 std::unique_ptr<StorageFile> openStorageFile(const fs::path& file) {

@@ -6,18 +6,8 @@
 namespace gvio::io::ros2 {
 namespace {
 
-// The root of `frame` following parent links (at most as many steps as links: no loop is kept).
-std::string rootOf(const std::vector<TfLink>& links, std::string frame) {
-  for (std::size_t step = 0; step <= links.size(); ++step) {
-    const auto up =
-        std::find_if(links.begin(), links.end(), [&](const TfLink& l) { return l.child == frame; });
-    if (up == links.end()) return frame;
-    frame = up->parent;
-  }
-  return frame;
-}
-
-// Every frame's pose in its tree's root, walking up parent links.
+// A frame's pose in its tree's root, walking up parent links, and the links walked; nullopt when
+// the walk does not end (a loop: more steps than links).
 std::optional<std::pair<Eigen::Isometry3d, std::vector<const TfLink*>>> toRoot(
     const std::vector<TfLink>& links, std::string frame) {
   Eigen::Isometry3d T_root_frame = Eigen::Isometry3d::Identity();
@@ -49,8 +39,9 @@ std::optional<std::string> TfTree::add(const TfLink& given) {
                                  [&](const TfLink& l) { return l.child == link.child; });
   if (same != next.end()) next.erase(same);
   next.push_back(link);
-  // A tf tree has one parent per frame; a loop would make a frame its own ancestor.
-  if (rootOf(next, link.parent) == link.child || !toRoot(next, link.child)) {
+  // A tf tree has one parent per frame; a loop through the new link brings the walk up from its
+  // child back to it, without end.
+  if (!toRoot(next, link.child)) {
     return "the link " + link.parent + " -> " + link.child + " would close a loop in the tree";
   }
   links_ = std::move(next);
