@@ -17,6 +17,17 @@ using ros2::Ros2Bag;
 using ros2::Ros2Error;
 using ros2::Ros2Topic;
 
+// Every message of t decoded, stamped with its receive time (the bag's log time).
+template <typename Decode>
+auto readAll(const Ros2Bag& bag, const Ros2Topic& t, Decode decode) {
+  std::vector<decltype(ros2::decodeMessage(bag, t, 0, decode))> out;
+  for (std::size_t i = 0; i < t.messages.size(); ++i) {
+    out.push_back(ros2::decodeMessage(bag, t, i, decode));
+    out.back().t.receive_ns = bag.logTimeNs(t, i);
+  }
+  return out;
+}
+
 // A ROS 2 bag's messages decoded from CDR into what the bag dataset reader takes; the receive
 // time is the bag's log time.
 class Ros2Source final : public BagSource {
@@ -32,25 +43,13 @@ class Ros2Source final : public BagSource {
   }
 
   std::vector<bag::ImuMessage> readImu(const std::string& name) const override {
-    const Ros2Topic& t = topic(name, ros2::kRos2ImuType);
-    std::vector<bag::ImuMessage> out;
-    for (std::size_t i = 0; i < t.messages.size(); ++i) {
-      out.push_back(ros2::decodeMessage(
-          *bag_, t, i, [](const auto& bytes) { return ros2::decodeImu(bytes).imu; }));
-      out.back().t.receive_ns = bag_->logTimeNs(t, i);
-    }
-    return out;
+    return readAll(*bag_, topic(name, ros2::kRos2ImuType),
+                   [](const auto& bytes) { return ros2::decodeImu(bytes).imu; });
   }
 
   std::vector<bag::NavSatFixMessage> readNavSatFix(const std::string& name) const override {
-    const Ros2Topic& t = topic(name, ros2::kRos2NavSatFixType);
-    std::vector<bag::NavSatFixMessage> out;
-    for (std::size_t i = 0; i < t.messages.size(); ++i) {
-      out.push_back(ros2::decodeMessage(
-          *bag_, t, i, [](const auto& bytes) { return ros2::decodeNavSatFix(bytes).fix; }));
-      out.back().t.receive_ns = bag_->logTimeNs(t, i);
-    }
-    return out;
+    return readAll(*bag_, topic(name, ros2::kRos2NavSatFixType),
+                   [](const auto& bytes) { return ros2::decodeNavSatFix(bytes).fix; });
   }
 
   std::vector<bag::Stamps> imageStamps(const std::string& name) const override {
