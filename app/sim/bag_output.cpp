@@ -9,6 +9,7 @@
 #include "io/input_error.hpp"
 #include "io/kalibr_writer.hpp"
 #include "io/ros_image.hpp"
+#include "sim/gnss_synth.hpp"
 
 namespace gvio::sim {
 namespace {
@@ -113,6 +114,9 @@ void BagOutput::finish(const std::vector<ImuSimSample>& imu, const std::vector<G
   }
   io::writeTextAtomic(out_ / "camchain.yaml", io::kalibrCamchainYaml(calibrated, topics, 0.0));
   io::writeTextAtomic(out_ / "imu.yaml", io::kalibrImuYaml(noise, imu_rate_hz, kImuTopic));
+  // The bag's fixes again as RTKLIB writes a solution: what a rig's post-processed GNSS looks like
+  // beside its bag (`gvio run --gnss-file drive.pos`).
+  io::writeTextAtomic(out_ / "drive.pos", toRtklibPos(fixes));
 }
 
 }  // namespace gvio::sim

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "io/gps_time.hpp"
 #include "io/nmea.hpp"
 #include "odometry/error.hpp"
 
@@ -70,8 +71,13 @@ std::string timeOfDay(std::int64_t t_ns) {
   return text;
 }
 
-// "ddmmyy" UTC of a Unix time (H. Hinnant's civil_from_days, the inverse of io::daysFromCivil).
-std::string dateOf(std::int64_t t_ns) {
+struct CivilDate {
+  std::int64_t year, month, day;
+};
+
+// The UTC calendar date of a Unix time (H. Hinnant's civil_from_days, the inverse of
+// io::daysFromCivil).
+CivilDate civilDateOf(std::int64_t t_ns) {
   const std::int64_t days = (t_ns >= 0 ? t_ns : t_ns - kNsPerDay + 1) / kNsPerDay;
   const std::int64_t z = days + 719468;
   const std::int64_t era = (z >= 0 ? z : z - 146096) / 146097;
@@ -81,8 +87,25 @@ std::string dateOf(std::int64_t t_ns) {
   const std::int64_t mp = (5 * doy + 2) / 153;
   const std::int64_t day = doy - (153 * mp + 2) / 5 + 1;
   const std::int64_t month = mp < 10 ? mp + 3 : mp - 9;
-  const std::int64_t year = yoe + era * 400 + (month <= 2 ? 1 : 0);
-  return fmt::format("{:02}{:02}{:02}", day, month, ((year % 100) + 100) % 100);
+  return {yoe + era * 400 + (month <= 2 ? 1 : 0), month, day};
+}
+
+// "ddmmyy" UTC of a Unix time.
+std::string dateOf(std::int64_t t_ns) {
+  const CivilDate d = civilDateOf(t_ns);
+  return fmt::format("{:02}{:02}{:02}", d.day, d.month, ((d.year % 100) + 100) % 100);
+}
+
+// "yyyy/mm/dd hh:mm:ss.sss" as RTKLIB writes its times; more decimals (up to 9) only when the
+// time is not on a 1 ms grid.
+std::string calendarTime(std::int64_t t_ns) {
+  const CivilDate d = civilDateOf(t_ns);
+  const std::int64_t tod = ((t_ns % kNsPerDay) + kNsPerDay) % kNsPerDay;
+  const std::int64_t s = tod / kNsPerSecond;
+  std::string text = fmt::format("{:04}/{:02}/{:02} {:02}:{:02}:{:02}.{:09}", d.year, d.month,
+                                 d.day, s / 3600, s / 60 % 60, s % 60, tod % kNsPerSecond);
+  while (text.size() > 23 && text.back() == '0') text.pop_back();
+  return text;
 }
 
 // "ddmm.mmmmmmm,N" / "dddmm.mmmmmmm,E": minutes rounded to 1e-7 (0.2 mm) in integers, so rounding
@@ -159,6 +182,39 @@ std::string toNmeaLog(const std::vector<GnssFix>& fixes) {
     }
   }
   return log;
+}
+
+std::string toRtklibPos(const std::vector<GnssFix>& fixes) {
+  // RTKLIB's Q of an NMEA quality (the inverse of io::nmeaQualityOfRtklibQ).
+  const auto q_of = [](int quality) {
+    switch (quality) {
+      case 4:
+        return 1;  // RTK fixed -> fix
+      case 5:
+        return 2;  // RTK float -> float
+      case 2:
+        return 4;  // DGPS
+      default:
+        return 5;  // single
+    }
+  };
+  std::string pos =
+      "% program   : gvio simulate\n"
+      "%  GPST                  latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   "
+      "sde(m)   sdu(m)  sdne(m)  sdeu(m)  sdun(m) age(s)  ratio\n";
+  for (const GnssFix& f : fixes) {
+    // GPST runs ahead of UTC by the leap seconds of that instant; io/gps_time.hpp's table is
+    // indexed by GPST, so the offset read at UTC is read again at the GPST it gives.
+    const std::int64_t utc_ahead_s = io::gpsMinusUtcSeconds(f.t_ns);
+    const std::int64_t t_gpst =
+        f.t_ns + io::gpsMinusUtcSeconds(f.t_ns + utc_ahead_s * kNsPerSecond) * kNsPerSecond;
+    pos += fmt::format(
+        "{} {:14.9f} {:14.9f} {:10.4f} {:3} {:3} {:8.4f} {:8.4f} {:8.4f} {:8.4f} {:8.4f} {:8.4f} "
+        "{:6.2f} {:6.1f}\n",
+        calendarTime(t_gpst), f.lat_deg, f.lon_deg, f.h_ellipsoid_m, q_of(f.quality), f.num_sats,
+        f.sigma_h_m, f.sigma_h_m, f.sigma_v_m, 0.0, 0.0, 0.0, 0.0, 0.0);
+  }
+  return pos;
 }
 
 std::string toGnssCsv(const std::vector<GnssFix>& fixes) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +13,7 @@
 
 #include "io/nmea.hpp"
 #include "io/reader_config.hpp"
+#include "io/rtklib_pos.hpp"
 #include "odometry/error.hpp"
 
 namespace gvio::sim {
@@ -300,6 +302,42 @@ TEST(SimGnss, NmeaRoundTripSouthWestAndOddTimes) {
   EXPECT_NEAR(read.fixes[0].h_ellipsoid_m, fix.h_ellipsoid_m, 1e-3);
   EXPECT_DOUBLE_EQ(read.fixes[0].sigma_h_m, 0.02);
   EXPECT_DOUBLE_EQ(read.fixes[0].sigma_v_m, 0.04);
+}
+
+// The .pos a rig's RTKLIB would write: read back by gvio's reader to the same instants (GPST
+// written, leap seconds of 1999 and 2023 applied both ways), positions, quality and satellites.
+TEST(SimGnss, RtklibPosRoundTrip) {
+  std::vector<GnssFix> fixes = reported(simulate(GnssNoise::kSpp, 10.0, 1.9));
+  ASSERT_EQ(fixes.size(), 20u);
+  fixes[3].quality = 4;
+  fixes[4].quality = 5;
+  fixes[5].quality = 2;
+  GnssFix odd = fixes.back();
+  odd.t_ns = 946'684'799 * kNs + 123'456'789;  // 1999-12-31 23:59:59.123456789 UTC
+  odd.lat_deg = -33.8567844;
+  odd.lon_deg = -151.2152967;
+  const std::string pos = toRtklibPos({odd});
+  EXPECT_NE(pos.find("2000/01/01 00:00:12.123456789 "), std::string::npos) << pos;  // GPST +13 s
+
+  const fs::path file =
+      fs::temp_directory_path() / ("gvio_sim_gnss_test_" + std::to_string(::getpid()) + ".pos");
+  fixes.push_back(odd);
+  std::sort(fixes.begin(), fixes.end(), [](auto& a, auto& b) { return a.t_ns < b.t_ns; });
+  std::ofstream(file, std::ios::binary) << toRtklibPos(fixes);
+  const io::PosFile read = io::readRtklibPos(file, io::ReaderConfig{});
+  fs::remove(file);
+  EXPECT_EQ(read.time_system, "GPST");
+  ASSERT_EQ(read.fixes.size(), fixes.size());
+  for (std::size_t i = 0; i < fixes.size(); ++i) {
+    EXPECT_EQ(read.fixes[i].t_ns, fixes[i].t_ns);
+    EXPECT_NEAR(read.fixes[i].lat_deg, fixes[i].lat_deg, 1e-9);
+    EXPECT_NEAR(read.fixes[i].lon_deg, fixes[i].lon_deg, 1e-9);
+    EXPECT_NEAR(read.fixes[i].h_ellipsoid_m, fixes[i].h_ellipsoid_m, 1e-4);
+    EXPECT_EQ(read.fixes[i].quality, fixes[i].quality);
+    EXPECT_EQ(read.fixes[i].num_sats, fixes[i].num_sats);
+    // Read sigmas are floored by the quality's UERE (io/rtklib_pos.hpp), never lowered.
+    EXPECT_GE(read.fixes[i].sigma_h_m, fixes[i].sigma_h_m - 1e-4);
+  }
 }
 
 TEST(SimGnss, GnssCsvFormat) {
