@@ -39,7 +39,7 @@ TEST_PACKAGES=(libgtest-dev libgmock-dev libbenchmark-dev)
 SANITIZER_PACKAGES=(clang-14 libfuzzer-14-dev libclang-rt-14-dev)
 case "$mode" in sanitize | fuzz) PACKAGES+=("${SANITIZER_PACKAGES[@]}") ;; esac
 # The documentation site needs nothing of the build: MkDocs and its Material theme alone.
-[ "$mode" = docs ] && PACKAGES=(mkdocs mkdocs-material python3)
+[ "$mode" = docs ] && PACKAGES=(mkdocs mkdocs-material python3-pymdownx python3 python3-matplotlib)
 
 install_packages() {
   local missing=()
@@ -148,6 +148,11 @@ case "$mode" in
   docs)
     # Strict: a broken link, a page missing from the nav or any other warning fails the build.
     # The generated references (docs/reference/) are checked against the program by ctest.
+    # The benchmark tables are generated from the committed outputs (tests/bench/results): a page
+    # that differs from them fails; the plots are drawn from them into the site's source (Debian's
+    # python3 and matplotlib, not a python of the user's PATH).
+    /usr/bin/python3 tests/tools/bench_results.py render --check
+    /usr/bin/python3 tests/tools/bench_results.py plots docs/benchmarks/plots
     mkdocs build --strict --site-dir "$BUILD_DIR/site"
     python3 tests/tools/check_markdown_links.py README.md CHANGELOG.md
     ;;
