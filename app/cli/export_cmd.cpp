@@ -36,11 +36,12 @@ Command addExportCommand(CLI::App& app) {
   auto o = std::make_shared<ExportCliOptions>();
   CLI::App* sub = app.add_subcommand(
       "export",
-      "Write a run's map or trajectory as PCD, PLY, LAS, OctoMap, TUM/KITTI/EuRoC or "
-      "GeoJSON/KML/GPX");
+      "Write a run's map or trajectory as PCD, PLY, LAS, 3D Tiles, OctoMap, TUM/KITTI/EuRoC "
+      "or GeoJSON/KML/GPX");
   sub->add_option("--run", o->run, "Run folder (the --out of gvio run)")->required();
   sub->add_option("--to", o->to, exporter::exportFormatList())->required();
-  sub->add_option("--out", o->out, "Output file (default: RUN/export.<ext>)");
+  sub->add_option("--out", o->out,
+                  "Output file, a folder for 3dtiles (default: RUN/export.<ext>, RUN/3dtiles)");
   return {sub, [o] { return runExport(*o); }};
 }
 

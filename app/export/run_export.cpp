@@ -1,5 +1,6 @@
 #include "export/run_export.hpp"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <array>
@@ -8,6 +9,7 @@
 #include "export/georef.hpp"
 #include "export/las_writer.hpp"
 #include "export/map_files.hpp"
+#include "export/tiles3d_writer.hpp"
 #include "fusion/geodesy.hpp"
 #include "io/input_error.hpp"
 #include "io/trajectory_io.hpp"
@@ -21,9 +23,10 @@ struct FormatInfo {
   std::string_view name, extension;
 };
 
-constexpr std::array<FormatInfo, 11> kFormats = {{{ExportFormat::kPcd, "pcd", ".pcd"},
+constexpr std::array<FormatInfo, 12> kFormats = {{{ExportFormat::kPcd, "pcd", ".pcd"},
                                                   {ExportFormat::kPly, "ply", ".ply"},
                                                   {ExportFormat::kLas, "las", ".las"},
+                                                  {ExportFormat::k3dTiles, "3dtiles", ""},
                                                   {ExportFormat::kBt, "bt", ".bt"},
                                                   {ExportFormat::kOt, "ot", ".ot"},
                                                   {ExportFormat::kTum, "tum", ".tum"},
@@ -113,6 +116,21 @@ ExportResult exportTrack(const fs::path& run, ExportFormat format, const fs::pat
   return r;
 }
 
+// The cloud's finite points with LAS's intensity and point source (the drive) scaling.
+std::vector<TilesPoint> tilesPoints(const pcl::PCLPointCloud2& cloud, const fs::path& source) {
+  const LasPointAt point_at = lasPointSource(cloud);
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  std::vector<TilesPoint> points;
+  points.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (const std::optional<LasPoint> p = point_at(k)) {
+      points.push_back({p->p_enu, p->intensity, p->point_source_id});
+    }
+  }
+  if (points.empty()) throw io::InputError(source, 0, "the map has no finite point");
+  return points;
+}
+
 ExportResult exportCloud(const fs::path& run, ExportFormat format, const fs::path& out) {
   ExportResult r;
   r.source = mapCloudFile(run);
@@ -121,6 +139,11 @@ ExportResult exportCloud(const fs::path& run, ExportFormat format, const fs::pat
   if (format == ExportFormat::kLas) {
     const Georef georef = readGeoref(requireFile(run / "georef.json", kMadeByGnss));
     r.count = writeMapLas(out, cloud, georef, r.source).points;
+  } else if (format == ExportFormat::k3dTiles) {
+    const Georef georef = readGeoref(requireFile(run / "georef.json", kMadeByGnss));
+    const Tiles3dSummary s = writeTiles3d(out, georef.enu_origin, tilesPoints(cloud, r.source));
+    r.count = s.points;
+    r.what = fmt::format("points in {} tiles, {} levels", s.tiles, s.depth + 1);
   } else {
     if (format == ExportFormat::kPcd) writePcd(out, cloud);
     if (format == ExportFormat::kPly) writePly(out, cloud);
@@ -142,8 +165,9 @@ ExportResult exportOctree(const fs::path& run, ExportFormat format, const fs::pa
   return r;
 }
 
-void checkOutput(const fs::path& out) {
-  if (fs::is_directory(out)) throw io::InputError(out, 0, "is a folder; --out names a file");
+void checkOutput(const fs::path& out, ExportFormat format) {
+  if (fs::is_directory(out) && format != ExportFormat::k3dTiles)
+    throw io::InputError(out, 0, "is a folder; --out names a file");
   const fs::path parent = fs::absolute(out).parent_path();
   if (!fs::is_directory(parent)) throw io::InputError(out, 0, "output folder does not exist");
 }
@@ -172,6 +196,7 @@ std::string extension(ExportFormat format) {
 }
 
 fs::path defaultExportPath(const fs::path& run_dir, ExportFormat format) {
+  if (format == ExportFormat::k3dTiles) return run_dir / "3dtiles";
   return run_dir / ("export" + extension(format));
 }
 
@@ -181,11 +206,12 @@ fs::path kittiTimesPath(const fs::path& poses) {
 
 ExportResult exportRun(const fs::path& run_dir, ExportFormat format, const fs::path& out) {
   if (!fs::is_directory(run_dir)) throw io::InputError(run_dir, 0, "run folder not found");
-  checkOutput(out);
+  checkOutput(out, format);
   switch (format) {
     case ExportFormat::kPcd:
     case ExportFormat::kPly:
     case ExportFormat::kLas:
+    case ExportFormat::k3dTiles:
       return exportCloud(run_dir, format, out);
     case ExportFormat::kBt:
     case ExportFormat::kOt:

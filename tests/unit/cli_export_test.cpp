@@ -9,6 +9,7 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 #include <pcl/point_types.h>
+#include <GeographicLib/Geocentric.hpp>
 #include <GeographicLib/LocalCartesian.hpp>
 #include <GeographicLib/UTMUPS.hpp>
 
@@ -17,6 +18,7 @@
 #include "run/gnss_run.hpp"
 #include "support/fixtures.hpp"
 #include "support/las_reader.hpp"
+#include "support/tiles3d_reader.hpp"
 
 namespace gvio::test {
 namespace {
@@ -126,6 +128,37 @@ TEST_F(CliExport, LasHoldsTheMapInUtmWithinAMillimetre) {
     EXPECT_LT((las.points[i].xyz - Eigen::Vector3d(e, n, g.z())).cwiseAbs().maxCoeff(), 0.001);
     EXPECT_EQ(las.points[i].intensity, static_cast<int>(expected[i].intensity) * 257);
   }
+}
+
+// 3D Tiles into the run's 3dtiles/ by default: the map's 300 points in ECEF, to a millimetre of
+// where GeographicLib puts them, with their intensity on LAS's 16-bit scale.
+TEST_F(CliExport, ThreeDTilesHoldTheMapInEcef) {
+  const auto r = runGvio("export --run " + run_.string() + " --to 3dtiles");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("300 points in 1 tiles"));
+  const Tileset ts = readTileset(run_ / "3dtiles");
+  ASSERT_EQ(ts.tiles.size(), 1u);
+  const PntsTile& tile = ts.tiles[0].content;
+  const auto expected = cloud();
+  ASSERT_EQ(tile.p_ecef.size(), expected.size());
+  const GeographicLib::LocalCartesian enu(kOrigin.lat_deg, kOrigin.lon_deg, kOrigin.h_ellipsoid_m);
+  const GeographicLib::Geocentric& earth = GeographicLib::Geocentric::WGS84();
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    const Eigen::Vector3d g = lla(expected[i].getVector3fMap().cast<double>());
+    Eigen::Vector3d ecef;
+    earth.Forward(g.y(), g.x(), g.z(), ecef.x(), ecef.y(), ecef.z());
+    EXPECT_LT((tile.p_ecef[i] - ecef).norm(), 0.001) << i;
+    EXPECT_EQ(tile.intensity[i], static_cast<int>(expected[i].intensity) * 257);
+    EXPECT_EQ(tile.drive_id[i], 0);
+  }
+  // Again over the same folder: replaced. A folder that is not a tileset: refused, kept.
+  ASSERT_EQ(runGvio("export --run " + run_.string() + " --to 3dtiles").exit_code, 0);
+  fs::create_directories(out("mine"));
+  writeText(out("mine") / "keep.txt", "x");
+  const auto refused = exportTo("3dtiles", out("mine"));
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_THAT(refused.err, HasSubstr("is not a tileset folder"));
+  EXPECT_TRUE(fs::exists(out("mine") / "keep.txt"));
 }
 
 TEST_F(CliExport, OctomapFilesRoundTrip) {
@@ -238,7 +271,8 @@ TEST_F(CliExport, BadInputIsOneLineExit2) {
     return "export --run " + run.string() + " --to " + to + extra;
   };
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {cmd(run_, "xyz"), "unknown format; one of pcd, ply, las, bt, ot, tum, kitti, euroc"},
+      {cmd(run_, "xyz"),
+       "unknown format; one of pcd, ply, las, 3dtiles, bt, ot, tum, kitti, euroc"},
       {cmd(dir_.path() / "missing", "pcd"), "run folder not found"},
       {cmd(bare, "pcd"), "map.pcd: not found"},
       {cmd(bare, "bt"), "map.bt: not found"},
