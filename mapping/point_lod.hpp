@@ -21,10 +21,10 @@
 namespace gvio::mapping {
 
 struct PointLodConfig {
-  int grid_cells = 64;                       // per axis, per node: a node holds up to 64^3 points
+  int grid_cells = 64;  // per axis, per node (a power of two): a node holds up to 64^3 points
   std::size_t max_points_per_node = 50'000;  // a node with at most this many keeps them all
-  int max_depth = 20;                        // a deeper node keeps everything left (duplicates)
-  void validate() const;                     // throws InvalidInput
+  int max_depth = 20;     // at most 20; a node this deep keeps everything left (duplicates)
+  void validate() const;  // throws InvalidInput
 };
 
 struct PointLodNode {
