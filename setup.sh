@@ -98,7 +98,7 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 # cases that run the whole 10 s drive (1.5-3.5 min each under ASan) are among them; the quick run
 # keeps the fault cases refused at the input. The quick run is 3.5 min at -j2 once built; it was
 # 20 min while the last 15 of these (CliMerge* to slurm_fleet, 34-250 s each) were still in it.
-QUICK_SANITIZE_EXCLUDE='^(CliGnssFile|CliKalibr|CliLoops|CliLoopsNoRevisit|CliLoopsRepetitive|CliMap|CliMapLoop|CliMerge|CliMergeAlign|CliRenderCamera|CliRosbag|CliRos2Bag|CliRunDeterminism|CliRunEndToEnd|CliRunGnss|CliRunThreads|CliTimeOffset|VioDrive|SimEndToEnd|SimWorldRenderTest|SimWorldStyles|SimWorldStylesRender|MappingSim)\.|^FeatureTrackerTest\.TracksPersist|^FaultInputs\.(.*Skips|FiveSecond)|^FaultGnss\.(Kilometre|Forward)|^FaultOutput\.(FileSize|Sig)|^FaultRos2\.|^CliFleet\.(Runs|Retries)|^CliConsistencyImages\.(TheTrue|PosesMoved|TheVio)|^CliConsistencyImagesRevisits\.|^slurm_fleet$'
+QUICK_SANITIZE_EXCLUDE='^(CliGnssFile|CliKalibr|CliLoops|CliLoopsNoRevisit|CliLoopsRepetitive|CliMap|CliMapLoop|CliMerge|CliMergeAlign|CliRenderCamera|CliRosbag|CliRos2Bag|CliRunDeterminism|CliRunEndToEnd|CliRunGnss|CliRunThreads|CliTimeOffset|VioDrive|SimEndToEnd|SimWorldRenderTest|SimWorldStyles|SimWorldStylesRender|MappingSim)\.|^FeatureTrackerTest\.TracksPersist|^FaultInputs\.(.*Skips|FiveSecond)|^FaultGnss\.(Kilometre|Forward)|^FaultOutput\.(FileSize|Sig)|^FaultRos2\.|^CliFleet\.(Runs|Retries)|^CliConsistencyImages\.(TheTrue|PosesMoved|TheVio)|^CliConsistencyImagesRevisits\.|^slurm_fleet$|^tutorial_'
 
 # What runs on threads, for ThreadSanitizer: the ordered worker and prefetcher, the VIO tracking
 # the next frame during the solve, and whole threaded runs of gvio (decoding ahead, keyframe work,

@@ -204,8 +204,11 @@ fs::path kittiTimesPath(const fs::path& poses) {
   return poses.parent_path() / (poses.stem().string() + "_times.txt");
 }
 
-ExportResult exportRun(const fs::path& run_dir, ExportFormat format, const fs::path& out) {
+ExportResult exportRun(const fs::path& run_dir, ExportFormat format, const fs::path& out_arg) {
   if (!fs::is_directory(run_dir)) throw io::InputError(run_dir, 0, "run folder not found");
+  // A folder given as "tiles/" is the folder "tiles".
+  const fs::path out =
+      format == ExportFormat::k3dTiles && !out_arg.has_filename() ? out_arg.parent_path() : out_arg;
   checkOutput(out, format);
   switch (format) {
     case ExportFormat::kPcd:

@@ -151,8 +151,10 @@ TEST_F(CliExport, ThreeDTilesHoldTheMapInEcef) {
     EXPECT_EQ(tile.intensity[i], static_cast<int>(expected[i].intensity) * 257);
     EXPECT_EQ(tile.drive_id[i], 0);
   }
-  // Again over the same folder: replaced. A folder that is not a tileset: refused, kept.
-  ASSERT_EQ(runGvio("export --run " + run_.string() + " --to 3dtiles").exit_code, 0);
+  // Again over the same folder, named with a slash: replaced. A folder that is not a tileset:
+  // refused, kept.
+  const auto again = exportTo("3dtiles", run_ / "3dtiles/");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
   fs::create_directories(out("mine"));
   writeText(out("mine") / "keep.txt", "x");
   const auto refused = exportTo("3dtiles", out("mine"));

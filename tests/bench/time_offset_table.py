@@ -1,0 +1,89 @@
+#!/usr/bin/env python3
+"""The camera-IMU time offset over the style matrix (issue 58): per vio_matrix.sh cell, the lag the
+drive was simulated with (its sim.yaml's camera_time_offset_s), what `gvio run` estimated
+(report.json time_offset: t_d +- sigma, or "not observed"), the share of the window's solves that
+observed it, and the APE against the same cell of a synchronised run when one is given.
+
+    BENCH_MODES=stereo-imu BENCH_SEEDS=1 BENCH_SIM_SET="sim.camera_time_offset_s=0.02" \\
+      BENCH_OUT=out/bench/vio_lag_0.02 tests/bench/vio_matrix.sh
+    tests/bench/time_offset_table.py --sync out/bench/vio_matrix out/bench/vio_lag_0.02 ...
+
+A benchmark's table, not a test: nothing asserts.
+"""
+import argparse
+import json
+import os
+import re
+import sys
+
+
+def load(path):
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
+
+
+def lag_of(cell):
+    try:
+        drive = open(os.path.join(cell, "drive.txt")).read().strip()
+        sim = open(os.path.join(drive, "sim.yaml")).read()
+    except OSError:
+        return None
+    m = re.search(r"^\s*camera_time_offset_s:\s*([0-9.eE+-]+)", sim, re.M)
+    return float(m.group(1)) if m else 0.0
+
+
+def ape(run):
+    ev = load(os.path.join(run, "eval.json"))
+    return ev["ape"]["rmse"] if ev else None
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("outs", nargs="+", help="vio_matrix.sh BENCH_OUT folders")
+    parser.add_argument("--sync", help="the BENCH_OUT of the same cells without a lag")
+    parser.add_argument("--mode", default="stereo-imu")
+    args = parser.parse_args()
+    print(f"Camera-IMU time offset, {args.mode}: the simulated lag, the estimate (report.json), "
+          "and the APE against the synchronised drive")
+    print()
+    print("| style | seed | lag (ms) | estimated (ms) | status | observed share | "
+          "APE (m) | synchronised APE (m) | APE change |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    within, within_2sigma, total = 0, 0, 0
+    for out in args.outs:
+        for cell in sorted(os.listdir(out)):
+            m = re.fullmatch(r"(.+)_seed(\d+)", cell)
+            run = os.path.join(out, cell, args.mode)
+            if not m or not os.path.isdir(run):
+                continue
+            lag = lag_of(os.path.join(out, cell))
+            rep = load(os.path.join(run, "report.json")) or {}
+            to = rep.get("time_offset", {})
+            status = to.get("status", "?")
+            total += 1
+            if status == "estimated":
+                est = f"{1e3 * to['t_d_s']:.1f} +- {1e3 * to['sigma_s']:.1f}"
+                error = abs(to["t_d_s"] - (lag or 0.0))
+                within += error <= 0.001
+                within_2sigma += error <= 2.0 * to["sigma_s"]
+            else:
+                est = status
+            share = to.get("observed_fraction")
+            a = ape(run)
+            s = ape(os.path.join(args.sync, cell, args.mode)) if args.sync else None
+            cells = [m.group(1), m.group(2), f"{1e3 * (lag or 0.0):.0f}", est, status,
+                     f"{share:.2f}" if share is not None else "",
+                     f"{a:.3f}" if a is not None else "failed",
+                     f"{s:.3f}" if s is not None else "",
+                     f"{100 * (a / s - 1):+.0f} %" if a and s else ""]
+            print("| " + " | ".join(cells) + " |")
+    print()
+    print(f"estimated within 1 ms of the lag: {within} of {total} cells; within two of its own "
+          f"stated sigmas: {within_2sigma} of {total}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
