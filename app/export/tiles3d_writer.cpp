@@ -1,11 +1,7 @@
 #include "export/tiles3d_writer.hpp"
 
-#include <fmt/format.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <bit>
-#include <cstring>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
