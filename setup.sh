@@ -12,6 +12,9 @@
 #                      SANITIZE_EXCLUDE (a ctest -E regex) skips tests of the ASan run
 #   ./setup.sh fuzz [SECONDS [TARGET...]]
 #                      every libFuzzer target (tests/fuzz) for SECONDS each (default 60)
+#   ./setup.sh viewer  the demo (as ./setup.sh demo) and its web viewer (gvio view) in
+#                      out/demo/run/viewer: node and npm from Debian, the page's npm packages from
+#                      app/view/web/package-lock.json
 #   ./setup.sh docs    the documentation site (MkDocs, strict) into build/site, and a check of
 #                      every relative link and image in README.md
 # Idempotent and non-interactive. Environment: BUILD_DIR (default build), JOBS (default nproc).
@@ -28,13 +31,16 @@ PACKAGES=(
   libgeographiclib-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev
   nlohmann-json3-dev libcairo2-dev zlib1g-dev
   librosbag-storage-dev libsensor-msgs-dev libroscpp-core-dev libbz2-dev
-  libzstd-dev liblz4-dev libsqlite3-dev
+  libzstd-dev liblz4-dev libsqlite3-dev libcpp-httplib-dev
 )
 # Only the modes that build the test suite need its frameworks.
 TEST_PACKAGES=(libgtest-dev libgmock-dev libbenchmark-dev)
-[ "$mode" != demo ] && PACKAGES+=("${TEST_PACKAGES[@]}")
+case "$mode" in demo | viewer) ;; *) PACKAGES+=("${TEST_PACKAGES[@]}") ;; esac
 # The fleet's Slurm test starts a single-node cluster (tests/fleet/slurm_fleet_test.sh).
 [ "$mode" = test ] && PACKAGES+=(slurm-wlm munge)
+# The web viewer's page is bundled with npm packages (node, npm) and tested in Debian's chromium.
+case "$mode" in test | viewer) PACKAGES+=(nodejs) ;; esac
+[ "$mode" = test ] && PACKAGES+=(chromium)
 # Sanitizers and libFuzzer come with clang.
 SANITIZER_PACKAGES=(clang-14 libfuzzer-14-dev libclang-rt-14-dev)
 case "$mode" in sanitize | fuzz) PACKAGES+=("${SANITIZER_PACKAGES[@]}") ;; esac
@@ -54,12 +60,28 @@ install_packages() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 }
 
+# The viewer page's npm packages, exactly as package-lock.json pins them (npm ci), before CMake
+# configures (it bundles the page when they are there). Debian's npm only where the nodejs
+# package did not bring one.
+install_viewer_packages() {
+  if ! command -v npm >/dev/null; then
+    local sudo=""
+    [ "$(id -u)" -ne 0 ] && sudo="sudo"
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends npm
+  fi
+  local web=app/view/web
+  if ! cmp -s "$web/package-lock.json" "$web/node_modules/.package-lock.json.installed"; then
+    (cd "$web" && npm ci --no-audit --no-fund --loglevel=error)
+    cp "$web/package-lock.json" "$web/node_modules/.package-lock.json.installed"
+  fi
+}
+
 # The demo builds the app alone (the test suite is most of the compile time); the other modes
 # build everything.
 build() {
   local werror=OFF tests=ON target=()
   [ -n "${CI:-}" ] && werror=ON  # warnings are errors in CI
-  if [ "$mode" = demo ]; then
+  if [ "$mode" = demo ] || [ "$mode" = viewer ]; then
     tests=OFF
     target=(--target gvio)
   fi
@@ -98,7 +120,7 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 # cases that run the whole 10 s drive (1.5-3.5 min each under ASan) are among them; the quick run
 # keeps the fault cases refused at the input. The quick run is 3.5 min at -j2 once built; it was
 # 20 min while the last 15 of these (CliMerge* to slurm_fleet, 34-250 s each) were still in it.
-QUICK_SANITIZE_EXCLUDE='^(CliGnssFile|CliKalibr|CliLoops|CliLoopsNoRevisit|CliLoopsRepetitive|CliMap|CliMapLoop|CliMerge|CliMergeAlign|CliRenderCamera|CliRosbag|CliRos2Bag|CliRunDeterminism|CliRunEndToEnd|CliRunGnss|CliRunThreads|CliTimeOffset|VioDrive|SimEndToEnd|SimWorldRenderTest|SimWorldStyles|SimWorldStylesRender|MappingSim)\.|^FeatureTrackerTest\.TracksPersist|^FaultInputs\.(.*Skips|FiveSecond)|^FaultGnss\.(Kilometre|Forward)|^FaultOutput\.(FileSize|Sig)|^FaultRos2\.|^CliFleet\.(Runs|Retries)|^CliConsistencyImages\.(TheTrue|PosesMoved|TheVio)|^CliConsistencyImagesRevisits\.|^slurm_fleet$|^tutorial_'
+QUICK_SANITIZE_EXCLUDE='^(CliGnssFile|CliKalibr|CliLoops|CliLoopsNoRevisit|CliLoopsRepetitive|CliMap|CliMapLoop|CliMerge|CliMergeAlign|CliRenderCamera|CliRosbag|CliRos2Bag|CliRunDeterminism|CliRunEndToEnd|CliRunGnss|CliRunThreads|CliTimeOffset|VioDrive|SimEndToEnd|SimWorldRenderTest|SimWorldStyles|SimWorldStylesRender|MappingSim)\.|^FeatureTrackerTest\.TracksPersist|^FaultInputs\.(.*Skips|FiveSecond)|^FaultGnss\.(Kilometre|Forward)|^FaultOutput\.(FileSize|Sig)|^FaultRos2\.|^CliFleet\.(Runs|Retries)|^CliConsistencyImages\.(TheTrue|PosesMoved|TheVio)|^CliConsistencyImagesRevisits\.|^slurm_fleet$|^tutorial_|^viewer_browser$'
 
 # What runs on threads, for ThreadSanitizer: the ordered worker and prefetcher, the VIO tracking
 # the next frame during the solve, and whole threaded runs of gvio (decoding ahead, keyframe work,
@@ -133,6 +155,7 @@ fuzz() {
 }
 
 install_packages
+case "$mode" in test | viewer) install_viewer_packages ;; esac
 case "$mode" in
   build) build ;;
   test)
@@ -156,7 +179,7 @@ case "$mode" in
     mkdocs build --strict --site-dir "$BUILD_DIR/site"
     python3 tests/tools/check_markdown_links.py README.md CHANGELOG.md
     ;;
-  demo)
+  demo | viewer)
     build
     # Simulate 20 s of the embedded drive (stereo, IMU, SPP GNSS, exact truth), then validate it.
     mkdir -p out/demo
@@ -178,9 +201,14 @@ case "$mode" in
     "$BUILD_DIR/app/gvio" consistency --run out/demo/run --images
     echo "setup: demo drive in out/demo/drive, run (trajectories, map.pcd/ply/las/bt/ot, report.json)" \
       "in out/demo/run, images in out/demo/run/render, the image check in out/demo/run/consistency_images"
+    if [ "$mode" = viewer ]; then
+      "$BUILD_DIR/app/gvio" view --run out/demo/run
+      echo "setup: the viewer in out/demo/run/viewer: open index.html in a browser, or serve it" \
+        "with $BUILD_DIR/app/gvio view --run out/demo/run --serve"
+    fi
     ;;
   *)
-    echo "usage: ./setup.sh [demo|test|build|sanitize [quick|thread|thread-quick]|fuzz [SECONDS [TARGET...]]]" >&2
+    echo "usage: ./setup.sh [demo|viewer|test|build|sanitize [quick|thread|thread-quick]|fuzz [SECONDS [TARGET...]]]" >&2
     exit 2
     ;;
 esac

@@ -26,6 +26,8 @@ pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)
 pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)
 pkg_check_modules(LZ4 REQUIRED IMPORTED_TARGET liblz4)
 pkg_check_modules(SQLITE3 REQUIRED IMPORTED_TARGET sqlite3)
+# gvio view --serve: a read-only static file server on loopback.
+pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
 
 # GeographicLib ships only a Find module on Debian (in /usr/share/cmake/geographiclib).
 list(APPEND CMAKE_MODULE_PATH /usr/share/cmake/geographiclib)

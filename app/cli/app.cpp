@@ -130,6 +130,7 @@ Cli buildCli(CommonOptions& common) {
   commands.push_back(addFleetCommand(app));
   commands.push_back(addFleetTaskCommand(app));
   commands.push_back(addMergeCommand(app));
+  commands.push_back(addViewCommand(app));
   return cli;
 }
 

@@ -47,6 +47,7 @@ Command addConsistencyCommand(CLI::App& app, const CommonOptions& common);
 Command addFleetCommand(CLI::App& app);
 Command addFleetTaskCommand(CLI::App& app);
 Command addMergeCommand(CLI::App& app);
+Command addViewCommand(CLI::App& app);
 
 // The whole command line, every subcommand registered, not yet parsed: runMain parses it, and the
 // CLI reference (docs/reference/cli.md, tests/unit/docs_reference_test.cpp) lists its subcommands

@@ -96,6 +96,9 @@ int RecordedCameraOverlay::width() const {
 int RecordedCameraOverlay::height() const {
   return state_->K.height;
 }
+const CameraModel& RecordedCameraOverlay::camera() const {
+  return state_->rectifier->left();
+}
 
 cv::Mat RecordedCameraOverlay::at(std::int64_t wanted_ns, std::string* frame_info) const {
   State& s = *state_;

@@ -41,6 +41,8 @@ class RecordedCameraOverlay {
   [[nodiscard]] const io::RunFiles& run() const;
   [[nodiscard]] int width() const;
   [[nodiscard]] int height() const;
+  // The rectified left camera the overlays are drawn for (pinhole, with its T_b_c).
+  [[nodiscard]] const CameraModel& camera() const;
   // The overlay (BGR) at the image nearest `t_ns` (within 0.2 s; InvalidInput else); `frame_info`
   // gets the image's stamp and file when given.
   cv::Mat at(std::int64_t t_ns, std::string* frame_info = nullptr) const;

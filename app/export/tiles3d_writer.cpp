@@ -137,24 +137,6 @@ class TilesetWriter {
   EcefOfEnu to_ecef_;
 };
 
-// A new folder beside `dir`, named like the atomic writer's temporaries (removed when stale).
-fs::path temporaryFolderFor(const fs::path& dir) {
-  const fs::path tmp = io::createTemporarySibling(dir);
-  fs::remove(tmp);
-  fs::create_directories(tmp / "tiles");
-  return tmp;
-}
-
-void replaceFolder(const fs::path& tmp, const fs::path& dir) {
-  std::error_code ec;
-  if (fs::exists(dir)) fs::remove_all(dir, ec);
-  if (!ec) fs::rename(tmp, dir, ec);
-  if (ec) {
-    fs::remove_all(tmp);
-    throw io::InputError(dir, 0, "cannot write the tileset: " + ec.message());
-  }
-}
-
 }  // namespace
 
 Tiles3dSummary writeTiles3d(const fs::path& dir, const fusion::Lla& enu_origin,
@@ -171,8 +153,8 @@ Tiles3dSummary writeTiles3d(const fs::path& dir, const fusion::Lla& enu_origin,
   if (tree.nodes.empty()) throw InvalidInput("3D Tiles: the cloud has no finite point");
   Tiles3dSummary summary;
   summary.points = tree.points;
-  const fs::path tmp = temporaryFolderFor(dir);
-  try {
+  io::writeFolderAtomic(dir, [&](const fs::path& tmp) {
+    fs::create_directory(tmp / "tiles");
     const TilesetWriter writer(tmp, points, tree, enu_origin);
     json root = writer.tile(0, summary);
     root["refine"] = "ADD";
@@ -181,11 +163,7 @@ Tiles3dSummary writeTiles3d(const fs::path& dir, const fusion::Lla& enu_origin,
                           {"geometricError", extent},
                           {"root", std::move(root)}};
     io::writeTextAtomic(tmp / "tileset.json", tileset.dump(1) + "\n");
-  } catch (...) {
-    fs::remove_all(tmp);
-    throw;
-  }
-  replaceFolder(tmp, dir);
+  });
   return summary;
 }
 

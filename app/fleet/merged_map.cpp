@@ -3,7 +3,10 @@
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <optional>
 
 #include "fusion/geodesy.hpp"
 #include "io/input_error.hpp"
@@ -43,6 +46,11 @@ void readTile(const fs::path& file, std::size_t stride, MergedMap& map) {
   const std::uint32_t z = fieldOffset(cloud, "z", F::FLOAT32, file);
   const std::uint32_t id = fieldOffset(cloud, "point_source_id", F::UINT16, file);
   const std::uint32_t kind = fieldOffset(cloud, "source", F::UINT8, file);
+  // Intensity (0..255 as float32) is optional: a tile without it reads as black.
+  std::optional<std::uint32_t> intensity;
+  for (const auto& f : cloud.fields) {
+    if (f.name == "intensity" && f.datatype == F::FLOAT32) intensity = f.offset;
+  }
   const std::size_t n = std::size_t{cloud.width} * cloud.height;
   if (cloud.data.size() < n * cloud.point_step) throw io::InputError(file, 0, "truncated tile");
   for (std::size_t k = 0; k < n; k += stride) {
@@ -57,6 +65,10 @@ void readTile(const fs::path& file, std::size_t stride, MergedMap& map) {
     map.points.emplace_back(v[0], v[1], v[2]);
     map.point_source_id.push_back(drive);
     map.source.push_back(p[kind]);
+    float i = 0.0F;
+    if (intensity) std::memcpy(&i, p + *intensity, 4);
+    map.intensity.push_back(
+        static_cast<std::uint8_t>(std::isfinite(i) ? std::clamp(i, 0.0F, 255.0F) + 0.5F : 0.0F));
   }
 }
 

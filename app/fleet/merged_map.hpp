@@ -32,6 +32,7 @@ struct MergedMap {
   std::vector<Eigen::Vector3f> points;         // map frame
   std::vector<std::uint16_t> point_source_id;  // one per point
   std::vector<std::uint8_t> source;            // one per point: 0 sparse landmark, 1 dense
+  std::vector<std::uint8_t> intensity;         // one per point (0..255), 0 where tiles lack it
   int utm_zone = 0;
   bool utm_north = true;
   Eigen::Vector3d origin_utm = Eigen::Vector3d::Zero();  // the map frame's origin: E, N, h

@@ -85,6 +85,27 @@ void writeViaPathAtomic(const fs::path& path, std::string_view suffix,
   moveIntoPlace(tmp, path);
 }
 
+void writeFolderAtomic(const fs::path& dir, const std::function<void(const fs::path& tmp)>& write) {
+  const fs::path tmp = createTemporarySibling(dir);
+  std::error_code ec;
+  fs::remove(tmp, ec);
+  if (!ec) fs::create_directory(tmp, ec);
+  if (ec) throw InputError(dir, 0, "cannot write the folder: " + ec.message());
+  try {
+    write(tmp);
+  } catch (...) {
+    fs::remove_all(tmp, ec);
+    throw;
+  }
+  if (fs::exists(dir)) fs::remove_all(dir, ec);
+  if (!ec) fs::rename(tmp, dir, ec);
+  if (ec) {
+    std::error_code ignored;
+    fs::remove_all(tmp, ignored);
+    throw InputError(dir, 0, "cannot write the folder: " + ec.message());
+  }
+}
+
 void writeFileAtomic(const fs::path& path, const std::function<void(std::ostream&)>& write) {
   const fs::path tmp = createTemporarySibling(path);
   auto discard = [&tmp] {

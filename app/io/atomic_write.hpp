@@ -33,6 +33,13 @@ void moveIntoPlace(const std::filesystem::path& tmp, const std::filesystem::path
 void writeViaPathAtomic(const std::filesystem::path& path, std::string_view suffix,
                         const std::function<void(const std::filesystem::path& tmp)>& write);
 
+// A whole folder the same way: `write` fills a new folder beside `dir` (named like the
+// temporaries above), which then replaces `dir` (an earlier one is removed first: the caller
+// checks that it is its own kind of folder). On any failure the new folder is removed and
+// InputError naming `dir` thrown (or `write`'s exception passed on).
+void writeFolderAtomic(const std::filesystem::path& dir,
+                       const std::function<void(const std::filesystem::path& tmp)>& write);
+
 // Whether `file` is named like one of our temporaries (any process's).
 bool isTemporaryName(const std::filesystem::path& file);
 

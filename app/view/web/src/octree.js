@@ -1,0 +1,159 @@
+// The point octree of data/points (app/view/view_points.hpp): nodes are loaded as the camera
+// comes near them and shown while their points are sparser on screen than minSpacingPx, nearest
+// and largest first, within a point budget (Schuetz 2016, "Potree", sec. 4: nodes by projected
+// size in a priority queue). Loaded nodes that are not drawn are dropped, oldest first, once the
+// page holds twice the budget.
+import * as THREE from 'three';
+import { decodeBase64, loadDataScript } from './data.js';
+
+const kMaxLoads = 4; // scripts in flight
+
+export class PointOctree {
+  constructor(index, material, parent) {
+    this.material = material;
+    this.group = new THREE.Group();
+    parent.add(this.group);
+    this.nodes = index.nodes.map((n) => ({
+      ...n,
+      box: new THREE.Box3(
+        new THREE.Vector3(n.bounds[0], n.bounds[1], n.bounds[2]),
+        new THREE.Vector3(n.bounds[3], n.bounds[4], n.bounds[5]),
+      ),
+      state: n.points > 0 ? 'none' : 'empty',
+      object: null,
+      lastDrawn: 0,
+    }));
+    this.pointBudget = 3_000_000;
+    this.minSpacingPx = 3;
+    this.loading = 0;
+    this.frame = 0;
+    this.loadedPoints = 0;
+    this.drawnPoints = 0;
+    this.drawnNodes = 0;
+    this.deepestDrawn = -1;
+    this.onLoad = () => {};
+    this.failed = [];
+  }
+
+  get root() {
+    return this.nodes[0];
+  }
+
+  // Chooses the nodes to draw from `camera` (a perspective camera) for a view `heightPx` tall,
+  // and starts loading the nodes wanted next.
+  update(camera, heightPx) {
+    ++this.frame;
+    const frustum = new THREE.Frustum().setFromProjectionMatrix(
+      new THREE.Matrix4().multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse),
+    );
+    const pxPerMetre = heightPx / (2 * Math.tan(THREE.MathUtils.degToRad(camera.fov) / 2));
+    const eye = camera.position;
+    const priority = (node) =>
+      (node.box.getSize(tmpSize).length() * pxPerMetre) /
+      Math.max(node.box.distanceToPoint(eye), 1e-3);
+    const heap = [[priority(this.root), 0]];
+    const wanted = [];
+    let budget = this.pointBudget;
+    let drawnPoints = 0,
+      drawnNodes = 0,
+      deepest = -1;
+    while (heap.length > 0) {
+      heap.sort((a, b) => a[0] - b[0]); // few hundred entries at most: sorting is cheap
+      const [p, i] = heap.pop();
+      const node = this.nodes[i];
+      if (!frustum.intersectsBox(node.box)) continue;
+      if (node.state !== 'empty') {
+        if (node.state !== 'loaded') {
+          if (node.state === 'none') wanted.push([p, node]);
+          continue; // its children wait for it: coarse levels first
+        }
+        if (budget < node.points) break;
+        budget -= node.points;
+        node.lastDrawn = this.frame;
+        drawnPoints += node.points;
+        ++drawnNodes;
+        deepest = Math.max(deepest, node.depth);
+      }
+      const spacingPx =
+        (node.spacing * pxPerMetre) / Math.max(node.box.distanceToPoint(eye), 1e-3);
+      if (node.spacing > 0 && spacingPx > this.minSpacingPx) {
+        for (const c of node.children) heap.push([priority(this.nodes[c]), c]);
+      }
+    }
+    for (const node of this.nodes) {
+      if (node.object) node.object.visible = node.lastDrawn === this.frame;
+    }
+    this.drawnPoints = drawnPoints;
+    this.drawnNodes = drawnNodes;
+    this.deepestDrawn = deepest;
+    wanted.sort((a, b) => b[0] - a[0]);
+    for (const [, node] of wanted) {
+      if (this.loading >= kMaxLoads) break;
+      this.load(node);
+    }
+    this.evict();
+  }
+
+  load(node) {
+    node.state = 'loading';
+    ++this.loading;
+    loadDataScript(`data/points/${node.name}.js`, `chunk:${node.name}`)
+      .then(([count, base64]) => {
+        node.object = this.makeObject(node, count, decodeBase64(base64));
+        node.state = 'loaded';
+        this.loadedPoints += count;
+        this.group.add(node.object);
+      })
+      .catch((error) => {
+        node.state = 'failed';
+        this.failed.push(String(error));
+        console.error(error);
+      })
+      .finally(() => {
+        --this.loading;
+        this.onLoad(node);
+      });
+  }
+
+  makeObject(node, n, bytes) {
+    const buffer = bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.byteLength);
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute(
+      'position',
+      new THREE.BufferAttribute(new Uint16Array(buffer, 0, 3 * n), 3, true),
+    );
+    geometry.setAttribute('drive', new THREE.BufferAttribute(new Uint16Array(buffer, 6 * n, n), 1));
+    geometry.setAttribute(
+      'intensity',
+      new THREE.BufferAttribute(new Uint8Array(buffer, 8 * n, n), 1, true),
+    );
+    geometry.setAttribute('kind', new THREE.BufferAttribute(new Uint8Array(buffer, 9 * n, n), 1));
+    const points = new THREE.Points(geometry, this.material);
+    points.frustumCulled = false; // the octree culls by node
+    points.position.set(node.cube[0], node.cube[1], node.cube[2]);
+    points.scale.setScalar(node.cube[3]);
+    points.visible = false;
+    return points;
+  }
+
+  evict() {
+    if (this.loadedPoints <= 2 * this.pointBudget) return;
+    const idle = this.nodes
+      .filter((n) => n.state === 'loaded' && n.lastDrawn !== this.frame && n !== this.root)
+      .sort((a, b) => a.lastDrawn - b.lastDrawn);
+    for (const node of idle) {
+      if (this.loadedPoints <= this.pointBudget) break;
+      this.group.remove(node.object);
+      node.object.geometry.dispose();
+      node.object = null;
+      node.state = 'none';
+      this.loadedPoints -= node.points;
+    }
+  }
+
+  get loadedNodes() {
+    return this.nodes.filter((n) => n.state === 'loaded').length;
+  }
+}
+
+const tmpSize = new THREE.Vector3();

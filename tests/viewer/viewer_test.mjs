@@ -1,0 +1,175 @@
+// Issue 62: gvio view's page in a real browser (Debian's chromium, headless, software GL),
+// driven by playwright-core (pinned in app/view/web/package-lock.json). Opened from its folder
+// (file://), the page must
+//   - load with no console error and no failed data file,
+//   - draw its first picture (the root node and the layers) and report when (first_picture_ms),
+//   - draw non-background pixels in the 3-D view,
+//   - show the expected trajectories, and the expected number of points in its octree,
+//   - load and draw deeper octree levels when the camera moves in,
+//   - show a keyframe's panel (and its image, when the site has images) when one is clicked.
+// Screenshots go to --shots. Prints one JSON line of figures; exits 1 on a failed check, 77 when
+// chromium is missing (ctest: skipped).
+//
+// node viewer_test.mjs --site DIR --shots DIR [--trajectories a,b] [--points N] [--keyframes]
+//                      [--chromium PATH] [--max-first-picture-ms MS]
+import { existsSync, mkdirSync } from 'node:fs';
+import { resolve } from 'node:path';
+import { pathToFileURL } from 'node:url';
+import { createRequire } from 'node:module';
+
+const args = Object.fromEntries(
+  process.argv.slice(2).reduce((acc, a, i, all) => {
+    if (a.startsWith('--')) acc.push([a.slice(2), all[i + 1]?.startsWith('--') ? true : all[i + 1] ?? true]);
+    return acc;
+  }, []),
+);
+const chromiumPath = args.chromium ?? '/usr/bin/chromium';
+if (!existsSync(chromiumPath)) {
+  console.log(`skipped: no chromium at ${chromiumPath} (./setup.sh test installs Debian's)`);
+  process.exit(77);
+}
+// playwright-core lives in the viewer's node_modules (one lock file for the page and its tests).
+const require = createRequire(resolve(args.web ?? 'app/view/web', 'package.json'));
+const { chromium } = require('playwright-core');
+
+const failures = [];
+const check = (ok, what) => {
+  if (!ok) failures.push(what);
+  console.error(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
+};
+
+const shots = resolve(args.shots);
+mkdirSync(shots, { recursive: true });
+const browser = await chromium.launch({
+  executablePath: chromiumPath,
+  args: ['--no-sandbox', '--use-gl=angle', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+    '--allow-file-access-from-files'],
+});
+const figures = {};
+try {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  const errors = [];
+  page.on('console', (m) => m.type() === 'error' && errors.push(m.text()));
+  page.on('pageerror', (e) => errors.push(String(e)));
+  page.on('requestfailed', (r) => errors.push(`failed: ${r.url()}`));
+  const url = pathToFileURL(resolve(args.site, 'index.html')).href;
+  await page.goto(url);
+  await page.waitForFunction(() => window.gvioViewer?.stats().firstPictureMs != null, null, {
+    timeout: 30000,
+  });
+  const settle = () =>
+    page.waitForFunction(
+      () => {
+        const s = window.gvioViewer.stats();
+        return s.loading === 0 && s.frames > 0;
+      },
+      null,
+      { timeout: 60000 },
+    );
+  await settle();
+  await page.waitForTimeout(300);
+  const first = await page.evaluate(() => window.gvioViewer.stats());
+  figures.first_picture_ms = Math.round(first.firstPictureMs);
+  const pixels = await page.evaluate(() => window.gvioViewer.nonBackgroundPixels());
+  figures.overview_pixels = pixels;
+  check(pixels > 1000, `the 3-D view draws ${pixels} non-background pixels (> 1000)`);
+  if (args['max-first-picture-ms']) {
+    const limit = Number(args['max-first-picture-ms']);
+    check(first.firstPictureMs <= limit, `first picture ${figures.first_picture_ms} ms (<= ${limit})`);
+  }
+  if (args.trajectories) {
+    const want = String(args.trajectories).split(',').sort();
+    check(JSON.stringify([...first.trajectories].sort()) === JSON.stringify(want),
+      `trajectories ${first.trajectories} (expected ${want})`);
+  }
+  if (args.points) {
+    check(first.pointsTotal === Number(args.points), `octree points ${first.pointsTotal} (expected ${args.points})`);
+  }
+  await page.screenshot({ path: `${shots}/overview.png` });
+
+  if (first.nodesTotal > 1) {
+    // From far away only the top of the tree is drawn; in close to the densest leaf, deeper
+    // nodes must load and be drawn.
+    const far = await page.evaluate(() => {
+      const b = window.gvioViewer.viewer.octree.root.bounds;
+      const c = [(b[0] + b[3]) / 2, (b[1] + b[4]) / 2, (b[2] + b[5]) / 2];
+      window.gvioViewer.lookAt(c, 20 * Math.hypot(b[3] - b[0], b[4] - b[1], b[5] - b[2]));
+      return c;
+    });
+    await page.waitForTimeout(200);
+    await settle();
+    const distant = await page.evaluate(() => window.gvioViewer.stats());
+    figures.deepest_far = distant.deepestDrawn;
+    check(far !== null && distant.deepestDrawn >= 0, `from far away the root is drawn (deepest ${distant.deepestDrawn})`);
+    const target = await page.evaluate(() => {
+      const nodes = window.gvioViewer.viewer.octree.nodes;
+      const leaf = nodes.filter((n) => n.children.length === 0).sort((a, b) => b.points - a.points)[0];
+      const b = leaf.bounds;
+      return { centre: [(b[0] + b[3]) / 2, (b[1] + b[4]) / 2, (b[2] + b[5]) / 2],
+        size: Math.hypot(b[3] - b[0], b[4] - b[1], b[5] - b[2]), depth: leaf.depth };
+    });
+    await page.evaluate(([c, d]) => window.gvioViewer.lookAt(c, d), [target.centre, Math.max(target.size, 5)]);
+    await page.waitForTimeout(200);
+    await settle();
+    await page.evaluate(() => window.gvioViewer.nonBackgroundPixels()); // one more frame
+    await settle();
+    const near = await page.evaluate(() => window.gvioViewer.stats());
+    figures.deepest_overview = first.deepestDrawn;
+    figures.deepest_near = near.deepestDrawn;
+    check(near.deepestDrawn > distant.deepestDrawn,
+      `moving in draws deeper levels (${distant.deepestDrawn} far -> ${near.deepestDrawn} near)`);
+    check(near.nodesLoaded > first.nodesLoaded,
+      `moving in loads more nodes (${first.nodesLoaded} -> ${near.nodesLoaded})`);
+    await page.screenshot({ path: `${shots}/near.png` });
+    await page.evaluate(() => document.getElementById('app') && window.gvioViewer.viewer.resetView());
+    await settle();
+  }
+
+  if (args.keyframes) {
+    check(first.keyframes > 0, `${first.keyframes} keyframes`);
+    await page.evaluate(() => window.gvioViewer.showKeyframes(true));
+    await page.waitForTimeout(100);
+    // A keyframe on screen and clear of the panel, clicked with the mouse.
+    const pick = await page.evaluate(() => {
+      const n = window.gvioViewer.stats().keyframes;
+      for (let k = Math.floor(n / 2), i = 0; i < n; ++i, k = (k + 1) % n) {
+        const p = window.gvioViewer.keyframeScreen(k);
+        if (p && p[0] > 300 && p[0] < innerWidth - 20 && p[1] > 20 && p[1] < innerHeight - 20) return [k, p];
+      }
+      return null;
+    });
+    check(pick !== null, 'a keyframe is on screen');
+    if (pick) {
+      await page.mouse.click(pick[1][0], pick[1][1]);
+      await page.waitForTimeout(200);
+      const shown = await page.evaluate(() => ({
+        selected: window.gvioViewer.selectedKeyframe(),
+        visible: getComputedStyle(document.getElementById('keyframe')).display !== 'none',
+        image: document.querySelector('#keyframe img')?.naturalWidth ?? null,
+      }));
+      check(shown.visible && shown.selected !== null, `clicking shows keyframe ${shown.selected}`);
+      if (shown.image !== null) {
+        await page.waitForFunction(() => document.querySelector('#keyframe img').complete);
+        const w = await page.evaluate(() => document.querySelector('#keyframe img').naturalWidth);
+        figures.keyframe_image_px = w;
+        check(w > 0, `its image loads (${w} px wide)`);
+      }
+      await page.screenshot({ path: `${shots}/keyframe.png` });
+    }
+  }
+  const last = await page.evaluate(() => window.gvioViewer.stats());
+  check(last.failed.length === 0, `no data file failed (${last.failed.join('; ')})`);
+  check(errors.length === 0, `no console error (${errors.join(' | ')})`);
+  figures.points_total = last.pointsTotal;
+  figures.nodes_total = last.nodesTotal;
+  figures.js_heap_mb = Math.round(
+    (await page.evaluate(() => performance.memory?.usedJSHeapSize ?? 0)) / 1e6,
+  );
+} finally {
+  await browser.close();
+}
+console.log(JSON.stringify(figures));
+if (failures.length > 0) {
+  console.error(`${failures.length} check(s) failed`);
+  process.exit(1);
+}
