@@ -1,9 +1,14 @@
 #include "mapping/point_lod.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
+#include <exception>
 #include <limits>
+#include <mutex>
+#include <string>
+#include <thread>
 #include <utility>
 
 #include "odometry/error.hpp"
@@ -24,20 +29,29 @@ Eigen::AlignedBox3d enclosingCube(const Eigen::AlignedBox3d& box) {
 // each level costs shifts instead of floating-point divisions (2 M points: 4x faster).
 constexpr int kBits = 30;
 
-class Builder {
- public:
-  Builder(std::span<const Eigen::Vector3d> p, const PointLodConfig& c,
-          const Eigen::AlignedBox3d& root)
-      : p_(p), c_(c), grid_bits_(std::countr_zero(static_cast<unsigned>(c.grid_cells))) {
-    q_.resize(p.size());
+// The integer positions, shared (read-only) by the builders of the root's subtrees.
+struct Quantised {
+  Quantised(std::span<const Eigen::Vector3d> p, const Eigen::AlignedBox3d& root) : q(p.size()) {
     const double scale = std::ldexp(1.0, kBits) / root.sizes().x();
     const double top = std::ldexp(1.0, kBits) - 1.0;
     for (std::size_t i = 0; i < p.size(); ++i) {
       if (!p[i].allFinite()) continue;
       const Eigen::Vector3d v = ((p[i] - root.min()) * scale).cwiseMax(0.0).cwiseMin(top);
-      q_[i] = {static_cast<std::uint32_t>(v.x()), static_cast<std::uint32_t>(v.y()),
-               static_cast<std::uint32_t>(v.z())};
+      q[i] = {static_cast<std::uint32_t>(v.x()), static_cast<std::uint32_t>(v.y()),
+              static_cast<std::uint32_t>(v.z())};
     }
+  }
+  std::vector<std::array<std::uint32_t, 3>> q;
+};
+
+class Builder {
+ public:
+  Builder(std::span<const Eigen::Vector3d> p, const PointLodConfig& c, const Quantised& q)
+      : p_(p), c_(c), grid_bits_(std::countr_zero(static_cast<unsigned>(c.grid_cells))), q_(q.q) {}
+
+  // Whether a node of `ids` at `depth` keeps them all (a leaf).
+  [[nodiscard]] bool keepsAll(std::size_t ids, int depth) const {
+    return ids <= c_.max_points_per_node || depth >= c_.max_depth;
   }
 
   // Places `ids` (increasing) in a new node of `cube` and its descendants; returns its index.
@@ -50,7 +64,7 @@ class Builder {
     node.depth = depth;
     node.cube = cube;
     std::array<std::vector<std::uint32_t>, 8> rest;
-    if (ids.size() <= c_.max_points_per_node || depth >= c_.max_depth) {
+    if (keepsAll(ids.size(), depth)) {
       node.points = std::move(ids);
     } else {
       sample(depth, ids, node, rest);
@@ -69,7 +83,6 @@ class Builder {
 
   PointLodTree take() { return std::move(tree_); }
 
- private:
   // The first point of each grid cell stays; every other goes to its octant's list.
   void sample(int depth, const std::vector<std::uint32_t>& ids, PointLodNode& node,
               std::array<std::vector<std::uint32_t>, 8>& rest) {
@@ -101,10 +114,65 @@ class Builder {
   std::span<const Eigen::Vector3d> p_;
   const PointLodConfig& c_;
   int grid_bits_;
-  std::vector<std::array<std::uint32_t, 3>> q_;  // integer positions in the root cube
-  std::vector<std::uint64_t> taken_;             // the sampled node's taken grid cells
+  const std::vector<std::array<std::uint32_t, 3>>& q_;  // integer positions in the root cube
+  std::vector<std::uint64_t> taken_;                    // the sampled node's taken grid cells
   PointLodTree tree_;
 };
+
+// The root sampled here, its eight subtrees built on `config.threads` threads, then laid out in
+// the order one thread would have made them (the root, then each octant's subtree depth first):
+// the same tree whatever the number of threads.
+void buildInParallel(std::span<const Eigen::Vector3d> p, const PointLodConfig& config,
+                     const Quantised& q, const Eigen::AlignedBox3d& root,
+                     const std::vector<std::uint32_t>& ids, PointLodTree& out) {
+  Builder top(p, config, q);
+  PointLodNode node;
+  node.name = "r";
+  node.cube = root;
+  std::array<std::vector<std::uint32_t>, 8> rest;
+  top.sample(0, ids, node, rest);
+  node.spacing_m = root.sizes().x() / static_cast<double>(config.grid_cells);
+  for (const std::uint32_t i : node.points) node.bounds.extend(p[i]);
+  std::array<PointLodTree, 8> sub;
+  std::atomic<int> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  const auto work = [&] {
+    for (int o = next++; o < 8; o = next++) {
+      if (rest[o].empty()) continue;
+      try {
+        Builder b(p, config, q);
+        b.place(std::string("r") + static_cast<char>('0' + o), 1, octant(root, o),
+                std::move(rest[o]));
+        sub[o] = b.take();
+      } catch (...) {  // bad_alloc
+        const std::lock_guard lock(error_mutex);
+        if (!error) error = std::current_exception();
+      }
+    }
+  };
+  const unsigned hw = std::max(1U, std::thread::hardware_concurrency());
+  const unsigned threads =
+      std::min(8U, config.threads > 0 ? static_cast<unsigned>(config.threads) : hw);
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+  out.nodes.push_back(std::move(node));
+  for (int o = 0; o < 8; ++o) {
+    if (sub[o].nodes.empty()) continue;
+    const int offset = static_cast<int>(out.nodes.size());
+    for (PointLodNode& n : sub[o].nodes) {
+      for (int& c : n.children) {
+        if (c >= 0) c += offset;
+      }
+      out.nodes.push_back(std::move(n));
+    }
+    out.nodes.front().children[o] = offset;
+    out.nodes.front().bounds.extend(out.nodes[static_cast<std::size_t>(offset)].bounds);
+  }
+}
 
 }  // namespace
 
@@ -115,6 +183,7 @@ void PointLodConfig::validate() const {
   }
   if (max_points_per_node < 1) throw InvalidInput("point LOD: max_points_per_node must be >= 1");
   if (max_depth < 0 || max_depth > 20) throw InvalidInput("point LOD: max_depth in [0, 20]");
+  if (threads < 0 || threads > 64) throw InvalidInput("point LOD: threads in [0, 64]");
 }
 
 Eigen::AlignedBox3d octant(const Eigen::AlignedBox3d& cube, int i) {
@@ -145,9 +214,15 @@ PointLodTree buildPointLod(std::span<const Eigen::Vector3d> p, const PointLodCon
   const std::size_t placed = ids.size();
   if (ids.empty()) return {};
   const Eigen::AlignedBox3d root = enclosingCube(box);
-  Builder builder(p, config, root);
-  builder.place("r", 0, root, std::move(ids));
-  PointLodTree tree = builder.take();
+  const Quantised q(p, root);
+  PointLodTree tree;
+  Builder top(p, config, q);
+  if (top.keepsAll(ids.size(), 0)) {
+    top.place("r", 0, root, std::move(ids));
+    tree = top.take();
+  } else {
+    buildInParallel(p, config, q, root, ids, tree);
+  }
   tree.points = placed;
   return tree;
 }

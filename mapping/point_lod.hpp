@@ -8,7 +8,8 @@
 //
 // A node keeps, in input order, the first point falling into each empty cell of a grid of
 // `grid_cells`^3 over its cube; a node with at most `max_points_per_node` points keeps them all
-// and has no children. Deterministic: the same points in the same order give the same tree.
+// and has no children. Deterministic: the same points in the same order give the same tree,
+// whatever the number of threads.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -24,6 +25,8 @@ struct PointLodConfig {
   int grid_cells = 64;  // per axis, per node (a power of two): a node holds up to 64^3 points
   std::size_t max_points_per_node = 50'000;  // a node with at most this many keeps them all
   int max_depth = 20;     // at most 20; a node this deep keeps everything left (duplicates)
+  int threads = 0;        // the root's subtrees built on this many threads (0: one per core);
+                          // the tree is the same whatever the number
   void validate() const;  // throws InvalidInput
 };
 

@@ -1,9 +1,13 @@
 #include "view/view_points.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <exception>
+#include <mutex>
+#include <thread>
 
 #include "io/atomic_write.hpp"
 #include "view/base64.hpp"
@@ -58,8 +62,8 @@ std::string chunkBytes(const ViewCloud& cloud, const mapping::PointLodNode& node
   const double scale = size > 0.0 ? 65535.0 / size : 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     const std::uint32_t i = node.points[k];
-    for (int a = 0; a < 3; ++a) {
-      const double q = std::clamp(std::round((cloud.p[i][a] - lo[a]) * scale), 0.0, 65535.0);
+    for (int a = 0; a < 3; ++a) {  // rounded to nearest (non-negative: + 0.5 and truncate)
+      const double q = std::clamp((cloud.p[i][a] - lo[a]) * scale + 0.5, 0.0, 65535.0);
       put(bytes, 6 * k + 2 * static_cast<std::size_t>(a), static_cast<std::uint16_t>(q));
     }
     put(bytes, 6 * n + 2 * k, cloud.drive[i]);
@@ -78,13 +82,35 @@ PointChunks writePointChunks(const std::filesystem::path& dir, const ViewCloud& 
   for (const mapping::PointLodNode& node : tree.nodes) {
     out.depth = std::max(out.depth, node.depth);
     out.index.push_back(nodeJson(node));
-    if (node.points.empty()) continue;
-    std::string script =
-        "gvioChunk(\"" + node.name + "\"," + std::to_string(node.points.size()) + ",\"";
-    appendBase64(script, chunkBytes(cloud, node));
-    script += "\");\n";
-    io::writeTextAtomic(dir / (node.name + ".js"), script);
   }
+  // The chunks are independent files: encoded and written on every core (the same files
+  // whatever the number of threads).
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  const auto work = [&] {
+    for (std::size_t i = next++; i < tree.nodes.size(); i = next++) {
+      const mapping::PointLodNode& node = tree.nodes[i];
+      if (node.points.empty()) continue;
+      try {
+        std::string script =
+            "gvioChunk(\"" + node.name + "\"," + std::to_string(node.points.size()) + ",\"";
+        appendBase64(script, chunkBytes(cloud, node));
+        script += "\");\n";
+        io::writeTextAtomic(dir / (node.name + ".js"), script);
+      } catch (...) {
+        const std::lock_guard lock(error_mutex);
+        if (!error) error = std::current_exception();
+        next = tree.nodes.size();
+      }
+    }
+  };
+  const unsigned threads = std::clamp(std::thread::hardware_concurrency(), 1U, 8U);
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
   return out;
 }
 

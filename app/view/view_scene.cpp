@@ -220,6 +220,7 @@ ViewInput readMergedForView(const fs::path& map_dir) {
                 {"origin_h_m", map.origin_utm.z()}};
   json tracks = json::array();
   for (const auto& d : map.drives) {
+    if (d.track_map.size() < 2) continue;  // no track in tiles.geojson
     json p = json::array();
     for (const auto& q : d.track_map) pushPoint(p, q);
     tracks.push_back({{"name", "drive " + std::to_string(d.point_source_id)},

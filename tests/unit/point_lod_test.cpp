@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
 #include <random>
 #include <set>
@@ -65,16 +66,28 @@ TEST(PointLod, EveryPointOnceInsideItsCube) {
   EXPECT_NEAR(tree.nodes[0].bounds.sizes().x(), 400.0, 1.0);
 }
 
-TEST(PointLod, Deterministic) {
+// The same tree on one thread and on many (the root's subtrees are built in parallel), its nodes
+// depth first (their names in lexicographic order).
+TEST(PointLod, DeterministicWhateverTheThreads) {
   const std::vector<Eigen::Vector3d> p = street(50'000, 2);
   PointLodConfig c;
   c.max_points_per_node = 2'000;
   c.grid_cells = 8;
-  const PointLodTree a = buildPointLod(p, c), b = buildPointLod(p, c);
-  ASSERT_EQ(a.nodes.size(), b.nodes.size());
-  for (std::size_t k = 0; k < a.nodes.size(); ++k) {
-    EXPECT_EQ(a.nodes[k].name, b.nodes[k].name);
-    EXPECT_EQ(a.nodes[k].points, b.nodes[k].points);
+  c.threads = 1;
+  const PointLodTree a = buildPointLod(p, c);
+  EXPECT_TRUE(std::is_sorted(a.nodes.begin(), a.nodes.end(),
+                             [](const auto& x, const auto& y) { return x.name < y.name; }));
+  for (const int threads : {1, 3, 8, 0}) {
+    c.threads = threads;
+    const PointLodTree b = buildPointLod(p, c);
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    for (std::size_t k = 0; k < a.nodes.size(); ++k) {
+      EXPECT_EQ(a.nodes[k].name, b.nodes[k].name);
+      EXPECT_EQ(a.nodes[k].points, b.nodes[k].points);
+      EXPECT_EQ(a.nodes[k].children, b.nodes[k].children);
+      EXPECT_TRUE(a.nodes[k].bounds.isApprox(b.nodes[k].bounds, 0.0));
+      EXPECT_EQ(a.nodes[k].spacing_m, b.nodes[k].spacing_m);
+    }
   }
 }
 

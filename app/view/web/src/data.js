@@ -30,6 +30,7 @@ export function deliver(key, ...args) {
 }
 
 export function decodeBase64(text) {
+  // A fresh buffer starting at offset 0, so typed arrays can view it at any aligned offset.
   if (typeof Uint8Array.fromBase64 === 'function') return Uint8Array.fromBase64(text);
   const binary = atob(text);
   const bytes = new Uint8Array(binary.length);

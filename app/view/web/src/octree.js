@@ -116,7 +116,7 @@ export class PointOctree {
   }
 
   makeObject(node, n, bytes) {
-    const buffer = bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.byteLength);
+    const buffer = bytes.buffer; // a fresh buffer of its own (decodeBase64)
     const geometry = new THREE.BufferGeometry();
     geometry.setAttribute(
       'position',
@@ -128,6 +128,17 @@ export class PointOctree {
       new THREE.BufferAttribute(new Uint8Array(buffer, 8 * n, n), 1, true),
     );
     geometry.setAttribute('kind', new THREE.BufferAttribute(new Uint8Array(buffer, 9 * n, n), 1));
+    // In the object's frame the points lie in the unit cube: bounds given, never computed (the
+    // arrays are gone once uploaded).
+    geometry.boundingBox = new THREE.Box3(new THREE.Vector3(0, 0, 0), new THREE.Vector3(1, 1, 1));
+    geometry.boundingSphere = new THREE.Sphere(new THREE.Vector3(0.5, 0.5, 0.5), Math.sqrt(3) / 2);
+    // Once on the GPU, the arrays are not needed again (the node is dropped, not edited): freed,
+    // they would double what a loaded point costs the page.
+    for (const attribute of Object.values(geometry.attributes)) {
+      attribute.onUpload(function release() {
+        this.array = null;
+      });
+    }
     const points = new THREE.Points(geometry, this.material);
     points.frustumCulled = false; // the octree culls by node
     points.position.set(node.cube[0], node.cube[1], node.cube[2]);
