@@ -266,6 +266,30 @@ TEST_F(ViewSite, ReplacesItsOwnSiteAndRefusesAnyOtherFolder) {
   EXPECT_TRUE(fs::exists(mine / "keep.txt"));
 }
 
+// Through the binary: a site for the run, and bad input refused in one line, exit 2.
+TEST_F(ViewSite, CliWritesTheSiteAndRefusesBadInputInOneLine) {
+  const bool built = !view::builtViewerPage().empty();
+  const auto ok = runGvio("view --run " + quoted(run_) + " --images 0");
+  if (built) {
+    ASSERT_EQ(ok.exit_code, 0) << ok.err;
+    EXPECT_THAT(ok.err, HasSubstr("400 points in 1 octree nodes"));
+    EXPECT_TRUE(view::isViewSite(run_ / "viewer"));
+  } else {
+    EXPECT_EQ(ok.exit_code, 2);
+    EXPECT_THAT(ok.err, HasSubstr("./setup.sh viewer"));
+  }
+  const auto missing = runGvio("view --run " + quoted(dir_.path() / "nope"));
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_THAT(missing.err, HasSubstr(built ? "run folder not found" : "./setup.sh viewer"));
+  EXPECT_EQ(std::count(missing.err.begin(), missing.err.end(), '\n'), 1) << missing.err;
+  if (!built) return;
+  writeText(dir_.path() / "mine" / "keep.txt", "x");
+  const auto refused =
+      runGvio("view --run " + quoted(run_) + " --images 0 --out " + quoted(dir_.path() / "mine"));
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_THAT(refused.err, HasSubstr("is not a gvio view site"));
+}
+
 // The folder over HTTP on loopback, nothing outside it, stopped on request.
 TEST_F(ViewSite, ServesTheFolderOnLoopbackOnly) {
   fs::create_directories(dir_.path() / "site" / "data");

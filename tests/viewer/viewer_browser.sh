@@ -23,6 +23,12 @@ trajectories=()
 [ -f "$work/run/trajectory_vio.tum" ] && trajectories+=(vio)
 [ -f "$work/run/groundtruth.tum" ] && [ -f "$work/run/georef.json" ] && trajectories+=(truth)
 points=$(grep -a -m1 '^POINTS ' "$work/run/map.pcd" | cut -d' ' -f2)
+# The same run as a merged map (gvio merge): its tiles' points and the drive's track.
+"$gvio" merge --runs "$work/run" --out "$work/map"
+"$gvio" view --run "$work/map"
+map_points=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["points"])' "$work/map/tiles.json")
 cd "$src"
 node tests/viewer/viewer_test.mjs --site "$work/site" --shots "$work/shots" \
   --trajectories "$(IFS=,; echo "${trajectories[*]}")" --points "$points" --keyframes
+node tests/viewer/viewer_test.mjs --site "$work/map/viewer" --shots "$work/shots/merged" \
+  --trajectories "drive 1" --points "$map_points"

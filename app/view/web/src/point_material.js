@@ -71,7 +71,12 @@ export function makePointMaterial() {
       uHeightRange: { value: new THREE.Vector2(0, 10) },
       uShowSparse: { value: true },
       uShowDense: { value: true },
-      uPalette: { value: drivePalette.map((c) => new THREE.Color(c)) },
+      // sRGB components as they are: the shader writes its colours without conversion.
+      uPalette: {
+        value: drivePalette.map(
+          (c) => new THREE.Vector3(((c >> 16) & 255) / 255, ((c >> 8) & 255) / 255, (c & 255) / 255),
+        ),
+      },
     },
   });
 }
