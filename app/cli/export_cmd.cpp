@@ -3,6 +3,8 @@
 
 #include "cli/app.hpp"
 #include "export/run_export.hpp"
+#include "fleet/merged_map.hpp"
+#include "fleet/merged_tiles3d.hpp"
 #include "io/run_dir.hpp"
 #include "odometry/error.hpp"
 
@@ -23,6 +25,17 @@ int runExport(const ExportCliOptions& o) {
   }
   const std::filesystem::path out =
       o.out ? std::filesystem::path(*o.out) : exporter::defaultExportPath(o.run, *format);
+  if (fleet::isMergedMap(o.run)) {
+    if (*format != exporter::ExportFormat::k3dTiles) {
+      throw InvalidInput("--run " + o.run +
+                         " is a merged map: its tiles are LAS and PCD already; it exports --to "
+                         "3dtiles");
+    }
+    const exporter::Tiles3dSummary s = fleet::exportMergedTiles3d(o.run, out);
+    spdlog::info("wrote {}: {} points in {} tiles, {} levels", out.string(), s.points, s.tiles,
+                 s.depth + 1);
+    return 0;
+  }
   if (const auto warning = io::incompleteRunWarning(o.run)) spdlog::warn("{}", *warning);
   const exporter::ExportResult r = exporter::exportRun(o.run, *format, out);
   for (const auto& file : r.written) spdlog::info("wrote {}", file.string());
@@ -38,7 +51,8 @@ Command addExportCommand(CLI::App& app) {
       "export",
       "Write a run's map or trajectory as PCD, PLY, LAS, 3D Tiles, OctoMap, TUM/KITTI/EuRoC "
       "or GeoJSON/KML/GPX");
-  sub->add_option("--run", o->run, "Run folder (the --out of gvio run)")->required();
+  sub->add_option("--run", o->run, "Run folder (the --out of gvio run), or a merged map (3dtiles)")
+      ->required();
   sub->add_option("--to", o->to, exporter::exportFormatList())->required();
   sub->add_option("--out", o->out,
                   "Output file, a folder for 3dtiles (default: RUN/export.<ext>, RUN/3dtiles)");

@@ -4,10 +4,13 @@
 //   3dtiles        the map cloud as OGC 3D Tiles (a folder: tileset.json + tiles/*.pnts, ECEF;
 //                  export/tiles3d_writer.hpp), needs georef.json
 //   las            the map cloud in UTM (zone of the ENU origin) + ellipsoidal height, needs
-//   georef.json bt, ot         map.bt / map.ot, read with OctoMap and written again tum, kitti,
-//   trajectory.tum (body in ENU); falls back to trajectory_vio.tum (VIO world frame, euroc not
-//   georeferenced) with a warning; kitti also writes <stem>_times.txt geojson, kml,  trajectory.tum
-//   in WGS 84 through georef.json's ENU origin gpx
+//                  georef.json
+//   bt, ot         map.bt / map.ot, read with OctoMap and written again
+//   tum, kitti,    trajectory.tum (body in ENU); falls back to trajectory_vio.tum (VIO world
+//   euroc          frame, not georeferenced) with a warning; kitti also writes <stem>_times.txt
+//   geojson, kml,  trajectory.tum in WGS 84 through georef.json's ENU origin
+//   gpx
+// A merged map exports to 3dtiles only: fleet/merged_tiles3d.hpp.
 #include <cstddef>
 #include <filesystem>
 #include <optional>

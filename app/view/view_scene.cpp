@@ -10,6 +10,7 @@
 #include "io/place_database_io.hpp"
 #include "io/run_dir.hpp"
 #include "io/trajectory_io.hpp"
+#include "view/view_plots.hpp"
 
 namespace gvio::view {
 namespace {
@@ -177,8 +178,11 @@ ViewInput readRunForView(const fs::path& run_dir) {
   s["title"] = fs::absolute(run_dir).lexically_normal().filename().string();
   const fs::path georef_file = run_dir / "georef.json";
   const std::optional<Eigen::Isometry3d> T_enu_w = vioToEnu(georef_file);
+  std::optional<SceneGeo> geo;
   if (fs::exists(georef_file)) {
     const exporter::Georef g = exporter::readGeoref(georef_file);
+    geo = SceneGeo{SceneGeo::Kind::kEnu, g.enu_origin, g.utm_zone, g.utm_north,
+                   Eigen::Vector3d::Zero()};
     s["frame"] = {{"type", "enu"},
                   {"lat_deg", g.enu_origin.lat_deg},
                   {"lon_deg", g.enu_origin.lon_deg},
@@ -189,6 +193,10 @@ ViewInput readRunForView(const fs::path& run_dir) {
     s["frame"] = {{"type", "vio"}};
   }
   s["trajectories"] = trajectoriesJson(run, T_enu_w);
+  if (geo) s["tracks2d"] = tracks2d(s["trajectories"], *geo);
+  s["errors"] = horizontalErrors(s["trajectories"]);
+  const fs::path scores = run_dir / "consistency_images" / "keyframes.csv";
+  if (fs::exists(scores)) s["consistency"] = consistencyScores(scores);
   if (run.gnss_fixes) s["fixes"] = fixesJson(*run.gnss_fixes);
   const Trajectory& along = run.fused ? *run.fused : *run.vio;
   if (run.loops) s["loops"] = loopsJson(*run.loops, along);
@@ -230,6 +238,8 @@ ViewInput readMergedForView(const fs::path& map_dir) {
                       {"p", std::move(p)}});
   }
   s["trajectories"] = std::move(tracks);
+  const SceneGeo geo{SceneGeo::Kind::kUtm, {}, map.utm_zone, map.utm_north, map.origin_utm};
+  s["tracks2d"] = tracks2d(s["trajectories"], geo);
   in.cloud.reserve(map.points.size());
   for (std::size_t k = 0; k < map.points.size(); ++k) {
     in.cloud.push(map.points[k].cast<double>(), map.intensity[k], map.source[k],

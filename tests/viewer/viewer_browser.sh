@@ -29,6 +29,6 @@ points=$(grep -a -m1 '^POINTS ' "$work/run/map.pcd" | cut -d' ' -f2)
 map_points=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["points"])' "$work/map/tiles.json")
 cd "$src"
 node tests/viewer/viewer_test.mjs --site "$work/site" --shots "$work/shots" \
-  --trajectories "$(IFS=,; echo "${trajectories[*]}")" --points "$points" --keyframes
+  --trajectories "$(IFS=,; echo "${trajectories[*]}")" --points "$points" --keyframes --plots 1
 node tests/viewer/viewer_test.mjs --site "$work/map/viewer" --shots "$work/shots/merged" \
   --trajectories "drive 1" --points "$map_points"

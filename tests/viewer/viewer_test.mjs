@@ -10,7 +10,9 @@
 // Screenshots go to --shots. Prints one JSON line of figures; exits 1 on a failed check, 77 when
 // chromium is missing (ctest: skipped).
 //
+//   - draw its tracks on the 2-D map (offline: the UTM grid) and the expected plots.
 // node viewer_test.mjs --site DIR --shots DIR [--trajectories a,b] [--points N] [--keyframes]
+//                      [--plots N]
 //                      [--chromium PATH] [--max-first-picture-ms MS]
 import { existsSync, mkdirSync } from 'node:fs';
 import { resolve } from 'node:path';
@@ -157,6 +159,15 @@ try {
       await page.screenshot({ path: `${shots}/keyframe.png` });
     }
   }
+  // The 2-D map (offline: the UTM grid) and the plots along the drive.
+  const side = await page.evaluate(() => window.gvioViewer.show2d());
+  figures.map2d_pixels = side.drawn;
+  check(side.tracks === first.trajectories.length && side.drawn > 500,
+    `the 2-D map draws ${side.tracks} tracks (${side.drawn} pixels)`);
+  if (args.plots) {
+    check(side.plots === Number(args.plots), `${side.plots} plots along the drive (expected ${args.plots})`);
+  }
+  await page.screenshot({ path: `${shots}/map2d.png` });
   const last = await page.evaluate(() => window.gvioViewer.stats());
   check(last.failed.length === 0, `no data file failed (${last.failed.join('; ')})`);
   check(errors.length === 0, `no console error (${errors.join(' | ')})`);

@@ -9,6 +9,9 @@ import { fixPoints, keyframeCameras, loadVoxels, loopEdges, trajectoryLine } fro
 import { PointOctree } from './octree.js';
 import { colorModes, makePointMaterial } from './point_material.js';
 import { buildPanel } from './ui.js';
+import { Map2d } from './map2d.js';
+import { buildPlots } from './plots.js';
+import uplotCss from 'uplot/dist/uPlot.min.css';
 
 const kBackground = 0x101418;
 
@@ -185,6 +188,15 @@ class Viewer {
     return lines.join('\n');
   }
 
+  // The 2-D map and the plots, made when first shown.
+  toggle2d(side) {
+    if (!this.side2d) {
+      this.side2d = { map: new Map2d(side, this.data), plots: buildPlots(side, this.data) };
+    }
+    side.style.display = side.style.display === 'block' ? 'none' : 'block';
+    return { tracks: this.side2d.map.tracks.length, plots: this.side2d.plots.length };
+  }
+
   // The keyframe nearest the click (within 10 px) when the pointer did not drag.
   onClick(e) {
     if (!this.down || Math.hypot(e.clientX - this.down[0], e.clientY - this.down[1]) > 3) return;
@@ -270,12 +282,22 @@ function testInterface(viewer) {
     },
     keyframeScreen: (k) => viewer.keyframeScreen(k),
     selectedKeyframe: () => viewer.selectedKeyframe ?? null,
+    // Opens the 2-D panel; returns the tracks and plots it drew and the map's drawn pixels.
+    show2d() {
+      const side = document.getElementById('panel2d');
+      if (side.style.display !== 'block') viewer.toggle2d(side);
+      const c = document.getElementById('map2d-canvas');
+      const px = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+      let drawn = 0;
+      for (let i = 0; i < px.length; i += 4) if (px[i] + px[i + 1] + px[i + 2] > 120) ++drawn;
+      return { tracks: viewer.side2d.map.tracks.length, plots: viewer.side2d.plots.length, drawn };
+    },
   };
 }
 
 window.gvioScene = (scene) => {
   const style = document.createElement('style');
-  style.textContent = css;
+  style.textContent = uplotCss + css;
   document.head.append(style);
   const viewer = new Viewer(document.getElementById('app'), scene);
   window.gvioViewer = testInterface(viewer);

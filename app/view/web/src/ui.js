@@ -1,6 +1,7 @@
 // The side panel: layers, colours, cameras, the point budget, live statistics and the report.
 import { colorModes } from './point_material.js';
 import { hex } from './colors.js';
+import { reportRows } from './plots.js';
 
 function el(tag, attrs = {}, ...children) {
   const e = document.createElement(tag);
@@ -81,11 +82,27 @@ export function buildPanel(root, viewer, scene) {
     panel.append(budget);
   }
 
+  const side = el('div', { id: 'panel2d' });
+  root.append(side);
+  panel.append(
+    el('button', {
+      id: 'toggle-2d',
+      text: '2-D map and plots',
+      onclick: () => viewer.toggle2d(side),
+    }),
+  );
+
   panel.append(el('h2', { text: 'Statistics' }));
   const stats = el('div', { id: 'stats' });
   panel.append(stats);
 
   if (scene.report) {
+    panel.append(el('h2', { text: 'Report' }));
+    const table = el('table', { id: 'report-figures' });
+    for (const [label, value] of reportRows(scene.report)) {
+      table.append(el('tr', {}, el('td', { text: label }), el('td', { text: value })));
+    }
+    panel.append(table);
     const details = el('details', { id: 'report' }, el('summary', { text: 'report.json' }));
     details.append(el('pre', { text: JSON.stringify(scene.report, null, 1) }));
     panel.append(details);
