@@ -236,6 +236,19 @@ KittiFixture demoFixture() {
   return spec;
 }
 
+Trajectory ellipseDrive() {
+  Trajectory t;
+  for (int i = 0; i < 100; ++i) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    const double a = 0.0628 * i;
+    T.translation() = Eigen::Vector3d(50 * std::cos(a), 30 * std::sin(a), 0.02 * i);
+    T.linear() = Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    t.poses.push_back(T);
+    t.t_ns.push_back(1'317'300'000'000'000'000LL + i * 100'000'000LL);
+  }
+  return t;
+}
+
 Trajectory demoDrive() {
   Trajectory t;
   double x = 0, y = 0, yaw = 0;

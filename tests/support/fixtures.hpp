@@ -52,6 +52,10 @@ KittiFixture demoFixture();
 // (assets/demo/drive.tum).
 Trajectory demoDrive();
 
+// 100 poses at 10 Hz around an ellipse (50 m x 30 m, rising 2 cm a pose), heading along it,
+// stamps from 1317300000 s: a georeferenced run's trajectory for the export and view tests.
+Trajectory ellipseDrive();
+
 // Path of the real data folder (../shared/data beside the project), empty when absent.
 std::filesystem::path sharedData(const std::string& relative);
 

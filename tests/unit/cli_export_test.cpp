@@ -27,19 +27,6 @@ using testing::HasSubstr;
 
 const fusion::Lla kOrigin{49.011, 8.4, 112.5};
 
-Trajectory loop() {
-  Trajectory t;
-  for (int i = 0; i < 100; ++i) {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    const double a = 0.0628 * i;
-    T.translation() = Eigen::Vector3d(50 * std::cos(a), 30 * std::sin(a), 0.02 * i);
-    T.linear() = Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    t.poses.push_back(T);
-    t.t_ns.push_back(1'317'300'000'000'000'000LL + i * 100'000'000LL);
-  }
-  return t;
-}
-
 pcl::PointCloud<pcl::PointXYZI> cloud() {
   pcl::PointCloud<pcl::PointXYZI> c;
   for (int i = 0; i < 300; ++i) {
@@ -66,10 +53,10 @@ class CliExport : public ::testing::Test {
     fs::create_directories(run_);
     run::GnssRunResult r;  // trajectory.tum and georef.json exactly as gvio run writes them
     r.origin = kOrigin;
-    r.fused = loop();
+    r.fused = ellipseDrive();
     r.T_enu_w = Eigen::Isometry3d::Identity();
     run::writeGeoreferencedOutputs(run_, r);
-    io::writeTum(run_ / "trajectory_vio.tum", loop());
+    io::writeTum(run_ / "trajectory_vio.tum", ellipseDrive());
     ASSERT_EQ(pcl::io::savePCDFileBinaryCompressed((run_ / "map.pcd").string(), cloud()), 0);
     octomap::OcTree tree(0.2);
     octomap::ColorOcTree color(0.2);
@@ -191,7 +178,7 @@ TEST_F(CliExport, OctomapFilesRoundTrip) {
 }
 
 TEST_F(CliExport, TrajectoryFormatsReimport) {
-  const Trajectory expected = loop();
+  const Trajectory expected = ellipseDrive();
   for (const auto& [format, name] :
        {std::pair{"tum", "t.tum"}, {"kitti", "t.txt"}, {"euroc", "t.csv"}}) {
     const auto r = exportTo(format, out(name));
@@ -210,7 +197,7 @@ TEST_F(CliExport, TrajectoryFormatsReimport) {
 }
 
 TEST_F(CliExport, GeoFormatsPlaceTheTrajectoryOnTheEarth) {
-  const Trajectory expected = loop();
+  const Trajectory expected = ellipseDrive();
   exporter::registerGdal();
   for (const std::string format : {"geojson", "kml", "gpx"}) {
     const auto r = exportTo(format, out("t." + format));
@@ -246,7 +233,7 @@ TEST_F(CliExport, DefaultOutputAndVioFallback) {
 
   const fs::path vio_only = dir_.path() / "vio_only";
   fs::create_directories(vio_only);
-  io::writeTum(vio_only / "trajectory_vio.tum", loop());
+  io::writeTum(vio_only / "trajectory_vio.tum", ellipseDrive());
   r = runGvio("export --run " + vio_only.string() + " --to kitti");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_THAT(r.err, HasSubstr("not georeferenced"));
@@ -258,8 +245,9 @@ TEST_F(CliExport, BadInputIsOneLineExit2) {
                  badgeo = dir_.path() / "badgeo", keyless = dir_.path() / "keyless",
                  broken = dir_.path() / "broken";
   for (const auto& d : {bare, nogeo, badgeo, keyless, broken}) fs::create_directories(d);
-  io::writeTum(bare / "trajectory_vio.tum", loop());
-  for (const auto& d : {nogeo, badgeo, keyless, broken}) io::writeTum(d / "trajectory.tum", loop());
+  io::writeTum(bare / "trajectory_vio.tum", ellipseDrive());
+  for (const auto& d : {nogeo, badgeo, keyless, broken})
+    io::writeTum(d / "trajectory.tum", ellipseDrive());
   writeText(badgeo / "georef.json", "{\"enu_origin\": ");
   writeText(keyless / "georef.json", R"({"enu_origin": {"lat_deg": 49.0, "lon_deg": 8.4}})");
   for (const auto& d : {badgeo, keyless}) fs::copy_file(run_ / "map.pcd", d / "map.pcd");

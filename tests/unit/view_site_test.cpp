@@ -156,30 +156,18 @@ TEST(ViewPoints, ChunksHoldEveryPointOnceQuantisedInTheirCube) {
 
 const fusion::Lla kOrigin{49.011, 8.4, 112.5};
 
-Trajectory loop() {
-  Trajectory t;
-  for (int i = 0; i < 100; ++i) {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    const double a = 0.0628 * i;
-    T.translation() = Eigen::Vector3d(50 * std::cos(a), 30 * std::sin(a), 0.02 * i);
-    t.poses.push_back(T);
-    t.t_ns.push_back(1'317'300'000'000'000'000LL + i * 100'000'000LL);
-  }
-  return t;
-}
-
 class ViewSite : public ::testing::Test {
  protected:
   void SetUp() override {
     fs::create_directories(run_);
     run::GnssRunResult r;
     r.origin = kOrigin;
-    r.fused = loop();
+    r.fused = ellipseDrive();
     Eigen::Isometry3d T_enu_w = Eigen::Isometry3d::Identity();
     T_enu_w.translation() = Eigen::Vector3d(5, 0, 0);
     r.T_enu_w = T_enu_w;
     run::writeGeoreferencedOutputs(run_, r);
-    io::writeTum(run_ / "trajectory_vio.tum", loop());
+    io::writeTum(run_ / "trajectory_vio.tum", ellipseDrive());
     writeText(run_ / "gnss_fixes.csv",
               "t_s,e_m,n_m,u_m,status\n1317300000.0,50,0,0,used\n1317300000.5,nan,nan,nan,"
               "unaligned\n1317300001.0,48,9,0,rejected\n");
