@@ -112,3 +112,27 @@ export async function loadVoxels() {
   mesh.frustumCulled = false;
   return mesh;
 }
+
+// The image check's keyframes (gvio consistency --images) where they were checked: ZNCC from red
+// (0) through yellow to green (1), the flagged ones magenta and larger, unscored ones grey.
+export function imageCheckMarkers(c) {
+  const positions = [],
+    colors = [];
+  const color = new THREE.Color();
+  for (let i = 0; i < c.t.length; ++i) {
+    const p = c.p.slice(3 * i, 3 * i + 3);
+    if (p.some((v) => v === null)) continue;
+    positions.push(...p);
+    if (c.flagged[i]) color.setHex(0xff00ff);
+    else if (c.ncc[i] === null) color.setHex(0x808080);
+    else color.setHSL((Math.min(Math.max(c.ncc[i], 0), 1) * 120) / 360, 0.9, 0.5);
+    colors.push(color.r, color.g, color.b);
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.Float32BufferAttribute(positions, 3));
+  geometry.setAttribute('color', new THREE.Float32BufferAttribute(colors, 3));
+  return new THREE.Points(
+    geometry,
+    new THREE.PointsMaterial({ size: 7, sizeAttenuation: false, vertexColors: true }),
+  );
+}

@@ -5,7 +5,14 @@ import css from './style.css';
 import { CameraRig } from './controls.js';
 import { fixColors, trajectoryColor } from './colors.js';
 import { deliver } from './data.js';
-import { fixPoints, keyframeCameras, loadVoxels, loopEdges, trajectoryLine } from './layers.js';
+import {
+  fixPoints,
+  imageCheckMarkers,
+  keyframeCameras,
+  loadVoxels,
+  loopEdges,
+  trajectoryLine,
+} from './layers.js';
 import { PointOctree } from './octree.js';
 import { colorModes, makePointMaterial } from './point_material.js';
 import { buildPanel } from './ui.js';
@@ -82,6 +89,11 @@ class Viewer {
       const extent = this.roughExtent(s);
       this.keyframeLayer = this.addLayer(`keyframes (${s.keyframes.t.length})`,
         keyframeCameras(s.keyframes, Math.max(extent / 200, 0.5)), false, 0xffd700);
+    }
+    if (s.consistency && s.consistency.t.length > 0) {
+      const flagged = s.consistency.flagged.filter((f) => f).length;
+      this.addLayer(`image check (${flagged} of ${s.consistency.t.length} flagged)`,
+        imageCheckMarkers(s.consistency), true, 0xff00ff);
     }
     if (s.voxels) {
       this.addLayer(`OctoMap voxels (${s.voxels.count})`, null, false, 0x88aacc, async (layer) => {
