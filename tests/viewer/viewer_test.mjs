@@ -120,8 +120,9 @@ try {
     figures.deepest_near = near.deepestDrawn;
     check(near.deepestDrawn > distant.deepestDrawn,
       `moving in draws deeper levels (${distant.deepestDrawn} far -> ${near.deepestDrawn} near)`);
-    check(near.nodesLoaded > first.nodesLoaded,
-      `moving in loads more nodes (${first.nodesLoaded} -> ${near.nodesLoaded})`);
+    // (Not "more nodes loaded than at the overview": the overview may already have loaded the
+    // nodes drawn in close, whether it did depends on the timing of the loads.)
+    figures.nodes_loaded_near = near.nodesLoaded;
     await page.screenshot({ path: `${shots}/near.png` });
     await page.evaluate(() => document.getElementById('app') && window.gvioViewer.viewer.resetView());
     await settle();
