@@ -54,16 +54,16 @@ class Builder {
     return ids <= c_.max_points_per_node || depth >= c_.max_depth;
   }
 
-  // Places `ids` (increasing) in a new node of `cube` and its descendants; returns its index.
-  int place(std::string name, int depth, const Eigen::AlignedBox3d& cube,
-            std::vector<std::uint32_t> ids) {
-    const int index = static_cast<int>(tree_.nodes.size());
-    tree_.nodes.emplace_back();
+  // A node of `cube` for `ids` (increasing): all of them for a leaf, else its grid sample, the
+  // rest going to `rest` by octant; its bounds are its own points' (the caller adds its
+  // children's).
+  PointLodNode node(std::string name, int depth, const Eigen::AlignedBox3d& cube,
+                    std::vector<std::uint32_t> ids,
+                    std::array<std::vector<std::uint32_t>, 8>& rest) {
     PointLodNode node;
     node.name = std::move(name);
     node.depth = depth;
     node.cube = cube;
-    std::array<std::vector<std::uint32_t>, 8> rest;
     if (keepsAll(ids.size(), depth)) {
       node.points = std::move(ids);
     } else {
@@ -71,6 +71,16 @@ class Builder {
       node.spacing_m = cube.sizes().x() / static_cast<double>(c_.grid_cells);
     }
     for (const std::uint32_t i : node.points) node.bounds.extend(p_[i]);
+    return node;
+  }
+
+  // Places `ids` (increasing) in a new node of `cube` and its descendants; returns its index.
+  int place(std::string name, int depth, const Eigen::AlignedBox3d& cube,
+            std::vector<std::uint32_t> ids) {
+    const int index = static_cast<int>(tree_.nodes.size());
+    tree_.nodes.emplace_back();
+    std::array<std::vector<std::uint32_t>, 8> rest;
+    PointLodNode node = this->node(std::move(name), depth, cube, std::move(ids), rest);
     for (int o = 0; o < 8; ++o) {
       if (rest[o].empty()) continue;
       node.children[o] = place(node.name + static_cast<char>('0' + o), depth + 1, octant(cube, o),
@@ -83,6 +93,7 @@ class Builder {
 
   PointLodTree take() { return std::move(tree_); }
 
+ private:
   // The first point of each grid cell stays; every other goes to its octant's list.
   void sample(int depth, const std::vector<std::uint32_t>& ids, PointLodNode& node,
               std::array<std::vector<std::uint32_t>, 8>& rest) {
@@ -124,15 +135,9 @@ class Builder {
 // the same tree whatever the number of threads.
 void buildInParallel(std::span<const Eigen::Vector3d> p, const PointLodConfig& config,
                      const Quantised& q, const Eigen::AlignedBox3d& root,
-                     const std::vector<std::uint32_t>& ids, PointLodTree& out) {
-  Builder top(p, config, q);
-  PointLodNode node;
-  node.name = "r";
-  node.cube = root;
+                     std::vector<std::uint32_t> ids, PointLodTree& out) {
   std::array<std::vector<std::uint32_t>, 8> rest;
-  top.sample(0, ids, node, rest);
-  node.spacing_m = root.sizes().x() / static_cast<double>(config.grid_cells);
-  for (const std::uint32_t i : node.points) node.bounds.extend(p[i]);
+  PointLodNode node = Builder(p, config, q).node("r", 0, root, std::move(ids), rest);
   std::array<PointLodTree, 8> sub;
   std::atomic<int> next{0};
   std::exception_ptr error;
@@ -221,7 +226,7 @@ PointLodTree buildPointLod(std::span<const Eigen::Vector3d> p, const PointLodCon
     top.place("r", 0, root, std::move(ids));
     tree = top.take();
   } else {
-    buildInParallel(p, config, q, root, ids, tree);
+    buildInParallel(p, config, q, root, std::move(ids), tree);
   }
   tree.points = placed;
   return tree;

@@ -69,9 +69,17 @@ RecordedCameraOverlay::RecordedCameraOverlay(const fs::path& run_dir,
                                              const std::optional<fs::path>& dataset,
                                              const viz::CameraViewOptions& options,
                                              viz::OverlayMode overlay)
+    : RecordedCameraOverlay(io::readMapRun(run_dir), dataset, options, overlay) {}
+
+RecordedCameraOverlay::RecordedCameraOverlay(io::RunFiles run,
+                                             const std::optional<fs::path>& dataset,
+                                             const viz::CameraViewOptions& options,
+                                             viz::OverlayMode overlay)
     : state_(std::make_unique<State>()) {
   State& s = *state_;
-  s.run = io::readMapRun(run_dir);
+  io::requireMapTimestamps(run);
+  s.run = std::move(run);
+  const fs::path run_dir = s.run.dir;
   std::string mode;
   s.ds = io::reopenRunDataset(run_dir, dataset, loadRunConfig(run_dir).dataset, mode);
   if (s.ds.cameras.empty()) throw InvalidInput(s.ds.root.string() + ": no camera");

@@ -34,6 +34,9 @@ class RecordedCameraOverlay {
   RecordedCameraOverlay(const std::filesystem::path& run_dir,
                         const std::optional<std::filesystem::path>& dataset,
                         const viz::CameraViewOptions& options, viz::OverlayMode overlay);
+  // The same over a run already read (with its map.pcd; `gvio view` reads it once for both).
+  RecordedCameraOverlay(io::RunFiles run, const std::optional<std::filesystem::path>& dataset,
+                        const viz::CameraViewOptions& options, viz::OverlayMode overlay);
   ~RecordedCameraOverlay();
   RecordedCameraOverlay(const RecordedCameraOverlay&) = delete;
   RecordedCameraOverlay& operator=(const RecordedCameraOverlay&) = delete;

@@ -35,9 +35,15 @@ int runView(const ViewCliOptions& o) {
       o.out ? std::filesystem::path(*o.out) : std::filesystem::path(o.run) / "viewer";
   if (const auto warning = io::incompleteRunWarning(o.run)) spdlog::warn("{}", *warning);
   const auto t0 = std::chrono::steady_clock::now();
-  view::ViewInput in = view::readViewInput(o.run);
-  if (!fleet::isMergedMap(o.run)) {
-    if (const auto why = addKeyframeImages(o.run, in, o.images)) {
+  view::ViewInput in;
+  if (fleet::isMergedMap(o.run)) {
+    in = view::readMergedForView(o.run);
+  } else {
+    // Read once: the scene, and the map the keyframe images draw.
+    io::RunFiles run = io::readRunDir(o.run);
+    in = view::readRunForView(run);
+    run.occupancy.reset();
+    if (const auto why = addKeyframeImages(std::move(run), in, o.images)) {
       spdlog::info("view: no keyframe images ({})", *why);
     }
   }

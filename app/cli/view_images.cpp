@@ -43,13 +43,13 @@ std::string jpegOf(const cv::Mat& bgr, int max_width_px) {
 
 }  // namespace
 
-std::optional<std::string> addKeyframeImages(const std::filesystem::path& run_dir,
-                                             view::ViewInput& in, const ViewImagesRequest& r) {
+std::optional<std::string> addKeyframeImages(io::RunFiles run, view::ViewInput& in,
+                                             const ViewImagesRequest& r) {
   if (r.max_images == 0) return "--images 0";
   std::unique_ptr<RecordedCameraOverlay> overlay;
   try {
-    overlay = std::make_unique<RecordedCameraOverlay>(run_dir, r.dataset, viz::CameraViewOptions{},
-                                                      viz::OverlayMode::kBlend);
+    overlay = std::make_unique<RecordedCameraOverlay>(
+        std::move(run), r.dataset, viz::CameraViewOptions{}, viz::OverlayMode::kBlend);
   } catch (const std::exception& e) {
     return std::string(e.what());
   }

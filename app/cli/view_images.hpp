@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "io/run_dir.hpp"
 #include "view/view_scene.hpp"
 
 namespace gvio::cli {
@@ -18,9 +19,10 @@ struct ViewImagesRequest {
   std::optional<std::filesystem::path> dataset;  // instead of report.json's sources
 };
 
-// Adds the images (and, without keyframes.bin, the keyframes) to `in`. Returns why there are
-// none instead (the run's recordings cannot be reopened, no camera): the site stays useful.
-std::optional<std::string> addKeyframeImages(const std::filesystem::path& run_dir,
-                                             view::ViewInput& in, const ViewImagesRequest& r);
+// Adds the images (and, without keyframes.bin, the keyframes) of `run` (read with its map.pcd:
+// the overlays draw it) to `in`. Returns why there are none instead (the run's recordings cannot
+// be reopened, no camera): the site stays useful.
+std::optional<std::string> addKeyframeImages(io::RunFiles run, view::ViewInput& in,
+                                             const ViewImagesRequest& r);
 
 }  // namespace gvio::cli

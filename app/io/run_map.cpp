@@ -22,10 +22,14 @@ RunFiles readMapRun(const fs::path& run_dir, bool with_cloud) {
   read.cloud = with_cloud;
   read.occupancy = read.gnss_fixes = read.outages = read.loops = false;
   RunFiles run = readRunDir(run_dir, read);
-  if (!mapTrajectory(run).hasTimestamps()) {
-    throw InputError(run_dir, 0, "the trajectory has no timestamps");
-  }
+  requireMapTimestamps(run);
   return run;
+}
+
+void requireMapTimestamps(const RunFiles& run) {
+  if (!mapTrajectory(run).hasTimestamps()) {
+    throw InputError(run.dir, 0, "the trajectory has no timestamps");
+  }
 }
 
 Dataset reopenRunDataset(const fs::path& run_dir, const std::optional<fs::path>& dataset,

@@ -17,6 +17,10 @@ namespace gvio::io {
 // InvalidInput naming the folder when it has neither.
 const Trajectory& mapTrajectory(const RunFiles& run);
 
+// Throws InputError naming the run's folder when its map trajectory has no timestamps (a view at
+// an instant cannot be placed on it).
+void requireMapTimestamps(const RunFiles& run);
+
 // The run's trajectories and (with_cloud) map.pcd, not the occupancy, fixes, outages or loops;
 // warns when the run did not complete. InputError when the trajectory has no timestamps.
 RunFiles readMapRun(const std::filesystem::path& run_dir, bool with_cloud = true);

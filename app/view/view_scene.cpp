@@ -170,8 +170,8 @@ json keyframesJson(const CameraModel& camera, const std::vector<KeyframeCamera>&
           {"pose", std::move(pose)}};
 }
 
-ViewInput readRunForView(const fs::path& run_dir) {
-  const io::RunFiles run = io::readRunDir(run_dir);
+ViewInput readRunForView(const io::RunFiles& run) {
+  const fs::path& run_dir = run.dir;
   ViewInput in;
   json& s = in.scene;
   s["kind"] = "run";

@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/run_dir.hpp"
 #include "odometry/measurements.hpp"
 #include "view/view_points.hpp"
 
@@ -40,9 +41,9 @@ struct KeyframeCamera {
 nlohmann::json keyframesJson(const CameraModel& camera,
                              const std::vector<KeyframeCamera>& keyframes);
 
-// A run folder (`gvio run --out`): every file present is shown, none but a trajectory is
-// required. Throws InputError naming the file that is missing or malformed.
-ViewInput readRunForView(const std::filesystem::path& run_dir);
+// A run folder (`gvio run --out`) as io::readRunDir reads it: every file present is shown, none
+// but a trajectory is required. Throws InputError naming the file that is missing or malformed.
+ViewInput readRunForView(const io::RunFiles& run);
 
 // A `gvio merge` folder: its tiles' points (every one) and the drives' tracks.
 ViewInput readMergedForView(const std::filesystem::path& map_dir);

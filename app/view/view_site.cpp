@@ -7,6 +7,7 @@
 #include "fleet/merged_map.hpp"
 #include "io/atomic_write.hpp"
 #include "io/input_error.hpp"
+#include "io/run_dir.hpp"
 #include "view/base64.hpp"
 #include "view/view_points.hpp"
 #include "view/view_scene.hpp"
@@ -83,7 +84,8 @@ bool isViewSite(const fs::path& dir) {
 }
 
 ViewInput readViewInput(const fs::path& input) {
-  return fleet::isMergedMap(input) ? readMergedForView(input) : readRunForView(input);
+  return fleet::isMergedMap(input) ? readMergedForView(input)
+                                   : readRunForView(io::readRunDir(input));
 }
 
 ViewSiteSummary writeViewSite(ViewInput& in, const fs::path& out, const fs::path& page_dir,
