@@ -1,17 +1,14 @@
 #include "mapping/point_lod.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <cmath>
-#include <exception>
 #include <limits>
-#include <mutex>
 #include <string>
-#include <thread>
 #include <utility>
 
 #include "odometry/error.hpp"
+#include "odometry/parallel_for.hpp"
 
 namespace gvio::mapping {
 namespace {
@@ -139,31 +136,13 @@ void buildInParallel(std::span<const Eigen::Vector3d> p, const PointLodConfig& c
   std::array<std::vector<std::uint32_t>, 8> rest;
   PointLodNode node = Builder(p, config, q).node("r", 0, root, std::move(ids), rest);
   std::array<PointLodTree, 8> sub;
-  std::atomic<int> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  const auto work = [&] {
-    for (int o = next++; o < 8; o = next++) {
-      if (rest[o].empty()) continue;
-      try {
-        Builder b(p, config, q);
-        b.place(std::string("r") + static_cast<char>('0' + o), 1, octant(root, o),
-                std::move(rest[o]));
-        sub[o] = b.take();
-      } catch (...) {  // bad_alloc
-        const std::lock_guard lock(error_mutex);
-        if (!error) error = std::current_exception();
-      }
-    }
-  };
-  const unsigned hw = std::max(1U, std::thread::hardware_concurrency());
-  const unsigned threads =
-      std::min(8U, config.threads > 0 ? static_cast<unsigned>(config.threads) : hw);
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
+  parallelFor(8, threadCount(config.threads, 8), [&](std::size_t o) {
+    if (rest[o].empty()) return;
+    Builder b(p, config, q);
+    b.place(std::string("r") + static_cast<char>('0' + o), 1, octant(root, static_cast<int>(o)),
+            std::move(rest[o]));
+    sub[o] = b.take();
+  });
   out.nodes.push_back(std::move(node));
   for (int o = 0; o < 8; ++o) {
     if (sub[o].nodes.empty()) continue;

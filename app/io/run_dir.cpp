@@ -75,16 +75,10 @@ std::vector<GnssFixRecord> readGnssFixes(const fs::path& file) {
     for (const auto f : splitDelimited(line, ',')) header.emplace_back(f);
   }
   if (header.empty()) in.fail("empty file, expected the header t_s,e_m,n_m,u_m,status");
-  // Columns by name, so that columns a later writer adds (sigmas, ...) are simply ignored.
   const std::array<const char*, 5> names = {"t_s", "e_m", "n_m", "u_m", "status"};
   std::array<std::size_t, 5> col{};
   for (std::size_t k = 0; k < names.size(); ++k) {
-    const auto it = std::find(header.begin(), header.end(), names[k]);
-    if (it == header.end()) {
-      in.fail(std::string("header has no column '") + names[k] +
-              "' (expected t_s,e_m,n_m,u_m,status)");
-    }
-    col[k] = static_cast<std::size_t>(it - header.begin());
+    col[k] = columnIndex(header, names[k], in, "t_s,e_m,n_m,u_m,status");
   }
   std::vector<GnssFixRecord> fixes;
   while (in.next(line)) {

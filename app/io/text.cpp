@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -91,6 +92,17 @@ std::vector<std::string_view> splitDelimited(std::string_view line, char delim) 
     start = pos + 1;
   }
   return fields;
+}
+
+std::size_t columnIndex(const std::vector<std::string>& header, std::string_view name,
+                        const LineReader& at, std::string_view expected) {
+  const auto it = std::find(header.begin(), header.end(), name);
+  if (it == header.end()) {
+    std::string message = "header has no column '" + std::string(name) + "'";
+    if (!expected.empty()) message += " (expected " + std::string(expected) + ")";
+    at.fail(message);
+  }
+  return static_cast<std::size_t>(it - header.begin());
 }
 
 std::vector<std::string_view> splitWhitespace(std::string_view line) {

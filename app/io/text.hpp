@@ -38,6 +38,11 @@ bool isBlankOrComment(std::string_view line, char comment = '#');
 
 // Splits on a single delimiter character, trimming each field.
 std::vector<std::string_view> splitDelimited(std::string_view line, char delim);
+// The index of the column called `name` in a CSV header (read by column name, so that columns a
+// later writer adds are simply ignored); fails at `at`'s line, naming the column and, when given,
+// the expected header.
+std::size_t columnIndex(const std::vector<std::string>& header, std::string_view name,
+                        const LineReader& at, std::string_view expected = {});
 // Splits on runs of spaces/tabs.
 std::vector<std::string_view> splitWhitespace(std::string_view line);
 

@@ -126,11 +126,7 @@ json consistencyScores(const std::filesystem::path& csv) {
   if (!reader.next(line)) reader.fail("empty; expected gvio consistency --images' keyframes.csv");
   std::vector<std::string> header;
   for (const auto f : io::splitDelimited(line, ',')) header.emplace_back(io::trim(f));
-  const auto column = [&](const char* name) {
-    const auto it = std::find(header.begin(), header.end(), name);
-    if (it == header.end()) reader.fail(std::string("no column '") + name + "'");
-    return static_cast<std::size_t>(it - header.begin());
-  };
+  const auto column = [&](const char* name) { return io::columnIndex(header, name, reader); };
   const std::size_t ct = column("t_from_start_s"), cx = column("x_m"), cy = column("y_m"),
                     cz = column("z_m"), cn = column("ncc"), cd = column("depth_agreement"),
                     cf = column("flagged");

@@ -1,15 +1,12 @@
 #include "view/view_points.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <exception>
-#include <mutex>
-#include <thread>
 
 #include "io/atomic_write.hpp"
+#include "odometry/parallel_for.hpp"
 #include "view/base64.hpp"
 
 namespace gvio::view {
@@ -85,32 +82,15 @@ PointChunks writePointChunks(const std::filesystem::path& dir, const ViewCloud& 
   }
   // The chunks are independent files: encoded and written on every core (the same files
   // whatever the number of threads).
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  const auto work = [&] {
-    for (std::size_t i = next++; i < tree.nodes.size(); i = next++) {
-      const mapping::PointLodNode& node = tree.nodes[i];
-      if (node.points.empty()) continue;
-      try {
-        std::string script =
-            "gvioChunk(\"" + node.name + "\"," + std::to_string(node.points.size()) + ",\"";
-        appendBase64(script, chunkBytes(cloud, node));
-        script += "\");\n";
-        io::writeTextAtomic(dir / (node.name + ".js"), script);
-      } catch (...) {
-        const std::lock_guard lock(error_mutex);
-        if (!error) error = std::current_exception();
-        next = tree.nodes.size();
-      }
-    }
-  };
-  const unsigned threads = std::clamp(std::thread::hardware_concurrency(), 1U, 8U);
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
+  parallelFor(tree.nodes.size(), threadCount(0, 8), [&](std::size_t i) {
+    const mapping::PointLodNode& node = tree.nodes[i];
+    if (node.points.empty()) return;
+    std::string script =
+        "gvioChunk(\"" + node.name + "\"," + std::to_string(node.points.size()) + ",\"";
+    appendBase64(script, chunkBytes(cloud, node));
+    script += "\");\n";
+    io::writeTextAtomic(dir / (node.name + ".js"), script);
+  });
   return out;
 }
 

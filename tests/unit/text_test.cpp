@@ -72,6 +72,23 @@ TEST(Text, Splitting) {
   EXPECT_FALSE(isBlankOrComment(" 1 # note"));
 }
 
+TEST(Text, ColumnsByNameNameFileLineAndExpectedHeader) {
+  test::TempDir dir("text");
+  test::writeText(dir.path() / "f.csv", "b,a,c\n1,2,3\n");
+  LineReader reader(dir.path() / "f.csv");
+  std::string line;
+  reader.next(line);
+  const std::vector<std::string> header = {"b", "a", "c"};
+  EXPECT_EQ(columnIndex(header, "a", reader), 1U);
+  EXPECT_EQ(columnIndex(header, "c", reader, "a,c"), 2U);
+  try {
+    (void)columnIndex(header, "d", reader, "a,d");
+    ADD_FAILURE() << "no column d";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("f.csv:1: header has no column 'd' (expected a,d)"));
+  }
+}
+
 TEST(Text, StrictNumbersNameFileAndLine) {
   test::TempDir dir("text");
   test::writeText(dir.path() / "f.txt", "first\nsecond\n");
