@@ -119,6 +119,9 @@ void ImageConsistencyConfig::validate() const {
     fail("min_flag_sigma must be > 0");
   }
   if (min_views_to_flag < 3) fail("min_views_to_flag must be >= 3");
+  if (similar_views != 0 && similar_views < min_views_to_flag) {
+    fail("similar_views must be 0 (off) or >= min_views_to_flag");
+  }
   if (!(min_ncc >= -1.0 && min_ncc <= 1.0)) fail("min_ncc must be in [-1, 1]");
   if (!(local_window_s > 0.0) || !std::isfinite(local_window_s)) {
     fail("local_window_s must be > 0");

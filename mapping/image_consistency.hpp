@@ -56,6 +56,20 @@ struct ImageConsistencyConfig {
   // ZNCC and depth_flag_sigmas for the depth agreement, whose residuals have heavier tails (a
   // share of pixels of whole surfaces: a parked car or a turn moves many at once). min_flag_sigma
   // keeps a drive whose views all agree alike from flagging noise.
+  // What is typical also depends on how near the drawn map is: a near surface is magnified (one
+  // 0.1 m voxel spans 8 px at 9 m on KITTI, 3.6 px at 20 m) and was measured by the sources from
+  // other directions, so a correct map reproduces it less well. With true poses on the seed-2
+  // KITTI-00 window (tests/bench/image_check_matrix.sh), the keyframes whose drawn map points lay
+  // at a median under 15 m (slow sharp turns at junctions, facing a wall: 21 of 259) scored a
+  // median 1.5-2 of their sigmas below their neighbours in time, the others 0. So a view's residual
+  // s - m is judged against the median and the spread of the residuals of the similar_views views
+  // whose drawn depth (ViewScore::drawn_depth_m) is nearest its own (in 1 / depth, the
+  // magnification), among the views more than local_window_s away in time (a faulty stretch's
+  // views are alike and must not be each other's reference), the spread never taken tighter than
+  // the whole drive's (a spread of a few dozen views is itself uncertain). A displaced pose moves
+  // the map in the image, not its depth, so a fault still stands out among its peers. Fewer such
+  // views, or 0: the view is judged against the whole drive alike.
+  std::size_t similar_views = 30;
   double local_window_s = 10.0;
   double flag_sigmas = 4.0;
   double depth_flag_sigmas = 5.0;
@@ -79,6 +93,10 @@ struct ViewScore {
   double depth_se = std::numeric_limits<double>::quiet_NaN();  // its standard error
   int depth_cells = 0;           // patches with enough pixels of both depths
   std::size_t depth_pixels = 0;  // pixels with a rendered and a stereo depth
+  // Set by the caller: the median depth (m) of the map points drawn in view (the nearest one per
+  // pixel), NaN: none known. The flag rule compares views drawn at similar depths
+  // (ImageConsistencyConfig::similar_views).
+  double drawn_depth_m = std::numeric_limits<double>::quiet_NaN();
   // Set by the caller: the map in view was measured only from behind the camera (no source
   // keyframe ahead of it: a forward camera's last keyframes of a drive). Its scores are biased
   // low (the surfaces ahead were seen from farther away, if at all), so flagOutliers judges it

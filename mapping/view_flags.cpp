@@ -57,36 +57,97 @@ std::vector<double> localMedians(const std::vector<double>& values, const std::v
   return out;
 }
 
-// One comparison (with the local medians or the drive's): per view the scale of its residual,
-// d = max(sqrt(tau^2 + se^2), min_flag_sigma), the standardised residual z = (v - ref) / d, and
-// the robust spread of z over the drive (at least 1: a drive is never trusted to be tighter than
-// its own errors say).
+// tau^2 = (1.4826 MAD of the residuals)^2 - the median se^2: the spread beyond the errors.
+double spreadBeyondErrors(const std::vector<double>& residuals, const std::vector<double>& se2) {
+  const double spread = robustSpread(residuals);
+  return std::sqrt(std::max(spread * spread - median(se2), 0.0));
+}
+
+// What views like each one show: the median shift and the spread tau of the residuals of the
+// `similar` views whose covariate is nearest its own, among the views more than apart_s away in
+// time (so that a faulty stretch is never its own reference: its views are alike too); ties by
+// index, so the result does not depend on the order of equal covariates. NaN for views without a
+// residual or a covariate, or with fewer than `similar` such views. The views sorted by covariate
+// once, each one's neighbours are a window grown around it from the nearer side.
+struct Similar {
+  std::vector<double> shift, tau;
+};
+
+Similar similarViews(const std::vector<double>& residual, const std::vector<double>& se2,
+                     const std::vector<double>& covariate, const std::vector<double>& t_s,
+                     std::size_t similar, double apart_s) {
+  const std::size_t n = residual.size();
+  Similar out{std::vector<double>(n, kNan), std::vector<double>(n, kNan)};
+  if (similar == 0) return out;
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (std::isfinite(residual[i]) && std::isfinite(covariate[i])) order.push_back(i);
+  }
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return std::make_pair(covariate[a], a) < std::make_pair(covariate[b], b);
+  });
+  std::vector<double> r, e2;
+  for (std::size_t pos = 0; pos < order.size(); ++pos) {
+    const std::size_t i = order[pos];
+    const double a = covariate[i];
+    r.clear();
+    e2.clear();
+    std::size_t lo = pos, hi = pos + 1;  // order[lo, hi) has been looked at
+    while (r.size() < similar && (lo > 0 || hi < order.size())) {
+      const bool take_lower = hi == order.size() ||
+                              (lo > 0 && a - covariate[order[lo - 1]] <= covariate[order[hi]] - a);
+      const std::size_t j = take_lower ? order[--lo] : order[hi++];
+      if (std::abs(t_s[j] - t_s[i]) <= apart_s) continue;
+      r.push_back(residual[j]);
+      e2.push_back(se2[j]);
+    }
+    if (r.size() < similar) continue;
+    out.shift[i] = median(r);
+    out.tau[i] = spreadBeyondErrors(r, e2);
+  }
+  return out;
+}
+
+// One comparison (with the local medians or the drive's): per view the shift and spread tau that
+// views like it show (similarViews; tau never below the drive's; the drive's tau and no shift
+// where the view has no covariate), the
+// scale of its residual d = max(sqrt(tau^2 + se^2), min_flag_sigma), the standardised residual
+// z = (v - ref - shift) / d, and the robust spread of z over the drive (at least 1: a drive is
+// never trusted to be tighter than its own errors say).
 struct Comparison {
-  std::vector<double> d, z;
+  std::vector<double> d, z, shift;
   double tau = kNan, z_spread = kNan;
 };
 
 Comparison compare(const std::vector<double>& values, const std::vector<double>& se,
-                   const std::vector<double>& reference, const ImageConsistencyConfig& c) {
+                   const std::vector<double>& reference, const std::vector<double>& covariate,
+                   const std::vector<double>& t_s, const ImageConsistencyConfig& c) {
   const std::size_t n = values.size();
   Comparison out;
   out.d.assign(n, kNan);
   out.z.assign(n, kNan);
+  out.shift.assign(n, 0.0);
   const auto error = [&](std::size_t i) { return std::isfinite(se[i]) ? se[i] : 0.0; };
-  std::vector<double> residuals, se2;
+  std::vector<double> residual(n, kNan), se2(n, kNan), residuals, se2s;
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(values[i]) || !std::isfinite(reference[i])) continue;
-    residuals.push_back(values[i] - reference[i]);
-    se2.push_back(error(i) * error(i));
+    residual[i] = values[i] - reference[i];
+    se2[i] = error(i) * error(i);
+    residuals.push_back(residual[i]);
+    se2s.push_back(se2[i]);
   }
   if (residuals.size() < c.min_views_to_flag) return out;
-  const double spread = robustSpread(residuals);
-  out.tau = std::sqrt(std::max(spread * spread - median(se2), 0.0));
+  out.tau = spreadBeyondErrors(residuals, se2s);
+  const Similar similar =
+      similarViews(residual, se2, covariate, t_s, c.similar_views, c.local_window_s);
   std::vector<double> z;
   for (std::size_t i = 0; i < n; ++i) {
-    if (!std::isfinite(values[i]) || !std::isfinite(reference[i])) continue;
-    out.d[i] = std::max(std::hypot(out.tau, error(i)), c.min_flag_sigma);
-    out.z[i] = (values[i] - reference[i]) / out.d[i];
+    if (!std::isfinite(residual[i])) continue;
+    const bool like = std::isfinite(similar.tau[i]);
+    out.shift[i] = like ? similar.shift[i] : 0.0;
+    const double tau = like ? std::max(similar.tau[i], out.tau) : out.tau;
+    out.d[i] = std::max(std::hypot(tau, error(i)), c.min_flag_sigma);
+    out.z[i] = (residual[i] - out.shift[i]) / out.d[i];
     z.push_back(out.z[i]);
   }
   out.z_spread = std::max(1.0, robustSpread(z));
@@ -99,7 +160,8 @@ struct Score {
   std::vector<double> value, se;
   std::vector<int> support;
   std::vector<bool> one_sided;  // judged by the floor alone
-  double k = 4.0;               // flagged this many sigmas below what is typical
+  std::vector<double> drawn_depth_m;
+  double k = 4.0;  // flagged this many sigmas below what is typical
   double floor = -std::numeric_limits<double>::infinity();
 };
 
@@ -139,13 +201,25 @@ ScoreThresholds thresholdsOf(const Score& s, const std::vector<double>& t_s,
   out.median = median(finiteOf(judged));
   const std::vector<double> se = nullSe(s, judged);
   const std::vector<double> local_median = localMedians(judged, t_s, c);
-  const Comparison local = compare(judged, se, local_median, c);
-  const Comparison drive = compare(judged, se, std::vector<double>(n, out.median), c);
+  // Views are alike when their drawn maps are alike magnified: 1 / depth (pixels per metre).
+  std::vector<double> magnification(n, kNan);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (s.drawn_depth_m[i] > 0.0) magnification[i] = 1.0 / s.drawn_depth_m[i];
+  }
+  const Comparison local = compare(judged, se, local_median, magnification, t_s, c);
+  const Comparison drive =
+      compare(judged, se, std::vector<double>(n, out.median), magnification, t_s, c);
   out.tau = local.tau;
   out.z_spread = local.z_spread;
   const double k = s.k;
-  const auto rule = [&](double below, double ref, double scale, const char* which) {
-    return fmt::format("{:.3f} = {} median {:.3f} - {:g} x {:.3f}", below, which, ref, k, scale);
+  // "0.214 = local median 0.552 - 0.098 as near - 4 x 0.060": the views drawn as near as this
+  // one sit 0.098 below their neighbours in time.
+  const auto rule = [&](double below, double ref, double shift, double scale, const char* which) {
+    const std::string near =
+        shift == 0.0 ? ""
+                     : fmt::format(" {} {:.3f} as near", shift < 0.0 ? '-' : '+', std::abs(shift));
+    return fmt::format("{:.3f} = {} median {:.3f}{} - {:g} x {:.3f}", below, which, ref, near, k,
+                       scale);
   };
   for (std::size_t i = 0; i < n; ++i) {
     const double v = s.value[i];
@@ -153,19 +227,21 @@ ScoreThresholds thresholdsOf(const Score& s, const std::vector<double>& t_s,
     std::string why;
     if (std::isfinite(local.z[i])) {
       const double scale = local.z_spread * local.d[i];
-      out.reference[i] = local_median[i];
+      out.reference[i] = local_median[i] + local.shift[i];
       out.z[i] = local.z[i] / local.z_spread;
       out.below[i] = out.reference[i] - k * scale;
-      if (v < out.below[i]) why = rule(out.below[i], out.reference[i], scale, "local");
+      if (v < out.below[i]) {
+        why = rule(out.below[i], local_median[i], local.shift[i], scale, "local");
+      }
     }
     // The drive's median where the neighbours are too few to tell what is typical (a drive's
     // ends with sparse keyframes): two tests on every view would double the false alarms.
     if (!std::isfinite(local.z[i]) && std::isfinite(drive.z[i])) {
       const double scale = drive.z_spread * drive.d[i];
-      out.reference[i] = out.median;
+      out.reference[i] = out.median + drive.shift[i];
       out.z[i] = drive.z[i] / drive.z_spread;
-      out.below[i] = out.median - k * scale;
-      if (v < out.below[i]) why = rule(out.below[i], out.median, scale, "drive");
+      out.below[i] = out.reference[i] - k * scale;
+      if (v < out.below[i]) why = rule(out.below[i], out.median, drive.shift[i], scale, "drive");
     }
     const double e = std::isfinite(s.se[i]) ? s.se[i] : 0.0;
     if (why.empty() && v + k * e < s.floor) {
@@ -201,11 +277,13 @@ FlaggedViews flagOutliers(const std::vector<ViewScore>& views, const std::vector
   if (!std::is_sorted(t_s.begin(), t_s.end())) {
     throw InvalidInput("image consistency: view times must ascend");
   }
-  Score ncc{"ncc", "patches", {}, {}, {}, {}, c.flag_sigmas, c.min_ncc};
-  Score depth{"depth agreement", "patches", {}, {}, {}, {}, c.depth_flag_sigmas};
+  Score ncc{"ncc", "patches", {}, {}, {}, {}, {}, c.flag_sigmas, c.min_ncc};
+  Score depth{"depth agreement", "patches", {}, {}, {}, {}, {}, c.depth_flag_sigmas};
   for (const ViewScore& v : views) {
     ncc.one_sided.push_back(v.one_sided);
     depth.one_sided.push_back(v.one_sided);
+    ncc.drawn_depth_m.push_back(v.drawn_depth_m);
+    depth.drawn_depth_m.push_back(v.drawn_depth_m);
     ncc.value.push_back(v.ncc);
     ncc.se.push_back(v.ncc_se);
     ncc.support.push_back(v.patches);

@@ -1,9 +1,10 @@
 #pragma once
 // Which views of a drive the image check flags (gvio consistency --images), from their scores
 // (mapping/image_consistency.hpp) alone: how well a correct map matches its image varies with the
-// world's texture and depth, slowly along a drive, so a view is flagged for a dip below what is
-// typical of its stretch of the drive or of the whole drive, measured in the drive's own spread
-// and the view's own standard error: a fault stands out whatever the world looks like, and a view
+// world's texture and depth, slowly along a drive, and with how near the drawn map is, so a view
+// is flagged for a dip below what is typical of its stretch of the drive (or of the whole drive)
+// and of the views drawn as near as it, measured in their own spread and the view's own standard
+// error: a fault stands out whatever the world looks like, and a view
 // with little support (few patches) needs a larger dip to be flagged. The rule and its parameters
 // are ImageConsistencyConfig's. No file I/O.
 #include <cstddef>
@@ -20,9 +21,11 @@ struct ScoreThresholds {
   double median = std::numeric_limits<double>::quiet_NaN();    // of the whole drive
   double tau = std::numeric_limits<double>::quiet_NaN();       // spread of correct views, beyond se
   double z_spread = std::numeric_limits<double>::quiet_NaN();  // of the standardised residuals
-  std::vector<double> reference;  // per view: the median it is compared with (NaN: none)
-  std::vector<double> below;      // per view: flagged below this (-inf: not judged)
-  std::vector<double> z;          // per view: standardised residual (NaN: not judged)
+  // per view: what is typical of it, the median it is compared with plus the shift of the views
+  // drawn as near (NaN: none)
+  std::vector<double> reference;
+  std::vector<double> below;  // per view: flagged below this (-inf: not judged)
+  std::vector<double> z;      // per view: standardised residual (NaN: not judged)
 };
 
 // Why a view is or is not flagged.

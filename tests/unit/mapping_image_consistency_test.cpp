@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <opencv2/core.hpp>
@@ -275,6 +276,66 @@ TEST(ImageConsistency, DepthAgreementIsJudgedAgainstTheDrivesOwnLevel) {
   EXPECT_THAT(dip.reason[40], testing::HasSubstr("over 80 patches"));
   views[40].depth_se = 0.15;  // a few disagreeing patches: not evidence enough
   EXPECT_FALSE(flagOutliers(views, times(100), {}).flagged[40]);
+}
+
+// Views whose map is drawn near (slow sharp turns facing a wall, 12 s apart) score lower and
+// spread wider with a correct map: judged among the views drawn as near elsewhere in the drive,
+// they flag nothing, while a dip below their own level, or a dip of a view drawn far, still flags.
+TEST(ImageConsistency, ViewsDrawnNearAreJudgedAmongTheViewsDrawnAsNear) {
+  const std::size_t n = 400;
+  std::vector<ViewScore> views = drive(n, 0.0, 0, 0);
+  std::mt19937 rng(11);
+  std::normal_distribution<double> wider(0.0, 0.04);
+  std::vector<bool> near(n, false);
+  for (std::size_t turn = 20; turn + 8 <= n; turn += 60) {
+    for (std::size_t i = turn; i < turn + 8; ++i) near[i] = true;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    views[i].drawn_depth_m = near[i] ? 8.0 : 20.0;
+    if (near[i]) views[i].ncc -= 0.1 + wider(rng);
+  }
+  ImageConsistencyConfig whole_drive;
+  whole_drive.similar_views = 0;
+  const FlaggedViews alike = flagOutliers(views, times(n), whole_drive);
+  EXPECT_GT(std::count(alike.flagged.begin(), alike.flagged.end(), true), 8);
+  const FlaggedViews peers = flagOutliers(views, times(n), {});
+  for (std::size_t i = 0; i < n; ++i) EXPECT_FALSE(peers.flagged[i]) << i;
+
+  views[84].ncc -= 0.3;   // below the views drawn as near
+  views[170].ncc -= 0.2;  // below the views drawn far
+  const FlaggedViews faults = flagOutliers(views, times(n), {});
+  for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(faults.flagged[i], i == 84 || i == 170) << i;
+  EXPECT_THAT(faults.reason[84], testing::HasSubstr("as near"));
+  EXPECT_LT(faults.ncc.reference[84], faults.ncc.reference[170] - 0.05);
+}
+
+// A faulty stretch's views are alike (here all drawn at 8 m, every other view at 20 m) but lie
+// within local_window_s of each other: they are never each other's reference, so the stretch
+// stands out against the views drawn as near elsewhere (none: the whole drive's level).
+TEST(ImageConsistency, AFaultyStretchIsNotItsOwnReference) {
+  const std::size_t n = 300;
+  std::vector<ViewScore> views = drive(n, 0.25, 200, 220);
+  for (std::size_t i = 0; i < n; ++i) views[i].drawn_depth_m = i >= 200 && i < 220 ? 8.0 : 20.0;
+  const FlaggedViews f = flagOutliers(views, times(n), {});
+  EXPECT_GE(std::count(f.flagged.begin() + 200, f.flagged.begin() + 220, true), 15);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i < 200 || i >= 220) {
+      EXPECT_FALSE(f.flagged[i]) << i;
+    }
+  }
+}
+
+// Without drawn depths (or with every view drawn alike) the rule is the whole drive's.
+TEST(ImageConsistency, WithoutDrawnDepthsEveryViewIsJudgedAgainstTheWholeDrive) {
+  const std::vector<ViewScore> views = drive(300, 0.25, 200, 210);
+  ImageConsistencyConfig whole_drive;
+  whole_drive.similar_views = 0;
+  const FlaggedViews a = flagOutliers(views, times(300), {});
+  const FlaggedViews b = flagOutliers(views, times(300), whole_drive);
+  EXPECT_EQ(a.flagged, b.flagged);
+  EXPECT_EQ(a.ncc.below, b.ncc.below);
+  whole_drive.similar_views = 3;  // fewer than min_views_to_flag: nothing typical to learn
+  EXPECT_THROW(whole_drive.validate(), InvalidInput);
 }
 
 TEST(ImageConsistency, StretchesJoinAcrossOneUnflaggedView) {
