@@ -187,6 +187,10 @@ Command addConsistencyCommand(CLI::App& app, const CommonOptions& common) {
   sub->add_option("--depth-flag-sigmas", ic.check.score.depth_flag_sigmas,
                   "--images: ... whose depth agreement lies this many sigmas below")
       ->capture_default_str();
+  sub->add_option("--similar-views", ic.check.score.similar_views,
+                  "--images: judge a keyframe against this many keyframes whose map points in "
+                  "view lie at the most similar depths (0: against the whole drive alike)")
+      ->capture_default_str();
   sub->add_flag("--no-revisits", ic.no_revisits,
                 "--images: do not check keyframes at revisits against the other passes' map");
   sub->add_option("--json", o->json, "Write the metrics as JSON");

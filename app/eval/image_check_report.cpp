@@ -139,7 +139,8 @@ std::string imageCheckCsv(const ImageCheckResult& c) {
       "t_s,t_from_start_s,x_m,y_m,z_m,ncc,ncc_flag_below,patches,coverage,depth_agreement,"
       "depth_flag_below,depth_pixels,source_keyframes,points_drawn,flagged,ms,ncc_se,depth_se,"
       "depth_patches,ncc_sigmas,depth_sigmas,status,reason,"
-      "revisit_sources,revisit_ncc,revisit_depth_agreement,revisit_status,revisit_reason\n";
+      "revisit_sources,revisit_ncc,revisit_depth_agreement,revisit_status,revisit_reason,"
+      "drawn_depth_m\n";
   std::size_t revisit = 0;  // index into c.revisit_rows
   for (std::size_t i = 0; i < c.rows.size(); ++i) {
     const ImageCheckRow& row = c.rows[i];
@@ -155,14 +156,15 @@ std::string imageCheckCsv(const ImageCheckResult& c) {
     }
     out += fmt::format(
         "{},{:.3f},{:.3f},{:.3f},{:.3f},{},{},{},{:.4f},{},{},{},{},{},{},{:.1f},{},{},{},{},{},{},"
-        "\"{}\",{}\n",
+        "\"{}\",{},{}\n",
         stamp(row.view.t_ns), c.t_s[i], row.p_map.x(), row.p_map.y(), row.p_map.z(),
         csvNumber(s.ncc, 4), csvNumber(c.flags.ncc.below[i], 4), s.patches, s.coverage,
         csvNumber(s.depth_agreement, 4), csvNumber(c.flags.depth.below[i], 4), s.depth_pixels,
         row.view.source_keyframes, row.view.points_drawn, row.flagged ? 1 : 0, row.view.ms,
         csvNumber(s.ncc_se, 4), csvNumber(s.depth_se, 4), s.depth_cells,
         csvNumber(c.flags.ncc.z[i], 2), csvNumber(c.flags.depth.z[i], 2),
-        mapping::toString(c.flags.status[i]), c.flags.reason[i], again);
+        mapping::toString(c.flags.status[i]), c.flags.reason[i], again,
+        csvNumber(s.drawn_depth_m, 2));
   }
   return out;
 }
@@ -209,6 +211,7 @@ nlohmann::json imageCheckSummary(const ImageCheckResult& c, std::size_t map_keyf
                     {"ncc_normal_false_alarm_rate", normalRate(score.flag_sigmas)},
                     {"depth_normal_false_alarm_rate", normalRate(score.depth_flag_sigmas)},
                     {"local_window_s", score.local_window_s},
+                    {"similar_views", score.similar_views},
                     {"min_ncc", score.min_ncc}};
   nlohmann::json flags = nlohmann::json::array();
   for (std::size_t i = 0; i < c.rows.size(); ++i) {

@@ -93,7 +93,8 @@ struct ImageCheck::State {
   void remember(std::size_t keyframe, const mapping::CameraCloud& raw);
   void trimCache();
   void ownInputs(std::size_t k, cv::Mat& recorded, cv::Mat& depth);
-  render::PointCloud pointsInView(std::size_t k, const std::vector<std::size_t>& sources);
+  render::PointCloud pointsInView(std::size_t k, const std::vector<std::size_t>& sources,
+                                  double& median_depth_m);
   void draw(render::PointCloud points, const render::RenderCamera& camera, CheckImages& out,
             cv::Mat& depth);
   cv::Mat stereoDepthImage(const mapping::CameraCloud& raw) const;
@@ -300,9 +301,10 @@ void ImageCheck::State::ownInputs(std::size_t k, cv::Mat& recorded, cv::Mat& dep
 }
 
 // The sources' points in view, the nearest per pixel only (farther ones could only be hidden), as
-// grey splats sized by their distance.
+// grey splats sized by their distance; median_depth_m gets their median depth (NaN: none).
 render::PointCloud ImageCheck::State::pointsInView(std::size_t k,
-                                                   const std::vector<std::size_t>& sources) {
+                                                   const std::vector<std::size_t>& sources,
+                                                   double& median_depth_m) {
   const Eigen::Isometry3d T_c_map = keyframes[k].T_map_c.inverse();
   std::vector<float> nearest_z(static_cast<std::size_t>(K.width) * K.height,
                                std::numeric_limits<float>::infinity());
@@ -323,15 +325,23 @@ render::PointCloud ImageCheck::State::pointsInView(std::size_t k,
     }
   }
   render::PointCloud points;
+  std::vector<float> depths;
   for (std::size_t px = 0; px < nearest.size(); ++px) {
     const auto [cloud, i] = nearest[px];
     if (cloud == nullptr) continue;
+    depths.push_back(nearest_z[px]);
     const float g = cloud->grey[i] / 255.0F;
     points.points.push_back(cloud->p_map[i].cast<double>());
     points.colors.emplace_back(g, g, g, 1.0F);
     points.sizes_px.push_back(
         std::clamp(static_cast<float>(K.fx * options.splat_m / static_cast<double>(nearest_z[px])),
                    kMinSplatPx, kMaxSplatPx));
+  }
+  median_depth_m = std::numeric_limits<double>::quiet_NaN();
+  if (!depths.empty()) {
+    const auto mid = depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 2);
+    std::nth_element(depths.begin(), mid, depths.end());
+    median_depth_m = static_cast<double>(*mid);
   }
   return points;
 }
@@ -366,12 +376,16 @@ mapping::ViewScore ImageCheck::State::scoreAgainst(std::size_t k,
                                                    const std::vector<std::size_t>& sources,
                                                    const cv::Mat& stereo_depth, CheckImages& drawn,
                                                    std::size_t& points_drawn) {
-  render::PointCloud points = pointsInView(k, sources);
+  double median_depth_m = 0.0;
+  render::PointCloud points = pointsInView(k, sources, median_depth_m);
   points_drawn = points.points.size();
   cv::Mat rendered_depth;
   draw(std::move(points), render::pinholeCamera(K, keyframes[k].T_map_c), drawn, rendered_depth);
-  return mapping::scoreView(drawn.recorded, drawn.rendered, drawn.covered, rendered_depth,
-                            stereo_depth, focal_baseline_px_m, options.score);
+  mapping::ViewScore score =
+      mapping::scoreView(drawn.recorded, drawn.rendered, drawn.covered, rendered_depth,
+                         stereo_depth, focal_baseline_px_m, options.score);
+  score.drawn_depth_m = median_depth_m;
+  return score;
 }
 
 CheckedView ImageCheck::check(std::size_t k, CheckImages* images) {

@@ -22,7 +22,7 @@ using testing::HasSubstr;
 namespace fs = std::filesystem;
 
 struct CsvRow {
-  double t_s = 0.0, ncc = 0.0, depth = 0.0;
+  double t_s = 0.0, ncc = 0.0, depth = 0.0, drawn_depth_m = 0.0;
   bool flagged = false;
   std::string status, reason;
 };
@@ -42,9 +42,10 @@ std::vector<CsvRow> readRows(const fs::path& csv) {
         f.back() += ch;
       }
     }
-    EXPECT_EQ(f.size(), 28U) << line;
-    if (f.size() != 28U) continue;
-    rows.push_back({std::stod(f[1]), std::stod(f[5]), std::stod(f[9]), f[14] == "1", f[21], f[22]});
+    EXPECT_EQ(f.size(), 29U) << line;
+    if (f.size() != 29U) continue;
+    rows.push_back({std::stod(f[1]), std::stod(f[5]), std::stod(f[9]), std::stod(f[28]),
+                    f[14] == "1", f[21], f[22]});
   }
   return rows;
 }
@@ -112,7 +113,12 @@ TEST_F(CliConsistencyImages, TheTruePosesAreFlaggedNowhere) {
   const nlohmann::json s = summary("truth");
   const std::size_t checked = s["keyframes"]["checked"].get<std::size_t>();
   EXPECT_GT(checked, 60U);  // 20 s at ~8 m/s, one map keyframe per 1.5 m
-  EXPECT_EQ(readRows(report("truth") / "keyframes.csv").size(), checked);
+  const std::vector<CsvRow> rows = readRows(report("truth") / "keyframes.csv");
+  EXPECT_EQ(rows.size(), checked);
+  for (const CsvRow& r : rows) {  // the map drawn in view: the demo's road and houses, 2-60 m
+    EXPECT_GT(r.drawn_depth_m, 2.0) << r.t_s;
+    EXPECT_LT(r.drawn_depth_m, 60.0) << r.t_s;
+  }
   for (const char* file : {"scores.png", "scores.svg"}) {
     EXPECT_TRUE(fs::exists(report("truth") / file)) << file;
   }
