@@ -8,11 +8,14 @@
 # rebuilds the map from it. Prints one table. A benchmark, not a test: nothing asserts.
 #
 # BENCH_RUN: the run folder (default: the KITTI-00 graph+loops run of tests/bench/vio_kitti00.sh).
+# BENCH_SIM: instead of a run, a simulated dataset folder (e.g. vio_kitti00.sh's cache
+# build/bench_cache/kitti00_full_seed1): its groundtruth.tum is checked (truth only, no VIO run).
 # BENCH_TRAJ: which of truth fused vio (default all three). BENCH_ARGS: more consistency options
 # (e.g. "--from 30 --to 60"). Work folder: BENCH_OUT (default build/bench_image_check).
 #
 #   tests/bench/image_check_kitti00.sh
 #   BENCH_TRAJ=fused BENCH_ARGS="--every 5" tests/bench/image_check_kitti00.sh
+#   BENCH_SIM=build/bench_cache/kitti00_full_seed1 tests/bench/image_check_kitti00.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 BUILD_DIR="${BUILD_DIR:-build}"
@@ -21,8 +24,30 @@ RUN="${BENCH_RUN:-out/bench/vio_kitti00_full/stereo-imu_graph}"
 OUT="${BENCH_OUT:-$BUILD_DIR/bench_image_check}"
 TRAJ="${BENCH_TRAJ:-truth fused vio}"
 [ -x "$GVIO" ] || { echo "bench: build gvio first ($GVIO)" >&2; exit 2; }
-for f in report.json trajectory.tum trajectory_vio.tum groundtruth.tum; do
-  [ -f "$RUN/$f" ] || { echo "bench: $RUN has no $f (set BENCH_RUN)" >&2; exit 2; }
+if [ -n "${BENCH_SIM:-}" ]; then
+  # A run folder of the simulation's sources alone (the map's settings are the defaults).
+  [ -f "$BENCH_SIM/sim.yaml" ] || { echo "bench: $BENCH_SIM is no simulated dataset" >&2; exit 2; }
+  RUN="$BUILD_DIR/bench_image_check_sim_run"
+  TRAJ=truth
+  rm -rf "$RUN"
+  mkdir -p "$RUN"
+  python3 - "$RUN/report.json" "$(realpath "$BENCH_SIM")" <<'PY'
+import json, sys
+json.dump({"mode": "stereo-imu", "sources": {"dataset": sys.argv[2], "format": "kitti-raw",
+           "calib_files": [], "gnss_file": None}}, open(sys.argv[1], "w"), indent=2)
+PY
+  cp "$BENCH_SIM/groundtruth.tum" "$RUN/groundtruth.tum"
+fi
+need=(report.json)
+for t in $TRAJ; do
+  case "$t" in
+    truth) need+=(groundtruth.tum) ;;
+    fused) need+=(trajectory.tum) ;;
+    vio) need+=(trajectory_vio.tum) ;;
+  esac
+done
+for f in "${need[@]}"; do
+  [ -f "$RUN/$f" ] || { echo "bench: $RUN has no $f (set BENCH_RUN or BENCH_SIM)" >&2; exit 2; }
 done
 rm -rf "$OUT"
 mkdir -p "$OUT"
