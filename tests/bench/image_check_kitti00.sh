@@ -29,14 +29,8 @@ if [ -n "${BENCH_SIM:-}" ]; then
   [ -f "$BENCH_SIM/sim.yaml" ] || { echo "bench: $BENCH_SIM is no simulated dataset" >&2; exit 2; }
   RUN="$BUILD_DIR/bench_image_check_sim_run"
   TRAJ=truth
-  rm -rf "$RUN"
-  mkdir -p "$RUN"
-  python3 - "$RUN/report.json" "$(realpath "$BENCH_SIM")" <<'PY'
-import json, sys
-json.dump({"mode": "stereo-imu", "sources": {"dataset": sys.argv[2], "format": "kitti-raw",
-           "calib_files": [], "gnss_file": None}}, open(sys.argv[1], "w"), indent=2)
-PY
-  cp "$BENCH_SIM/groundtruth.tum" "$RUN/groundtruth.tum"
+  python3 tests/bench/trajectory_run.py "$RUN" "$BENCH_SIM" "$BENCH_SIM/groundtruth.tum" \
+    groundtruth.tum
 fi
 need=(report.json)
 for t in $TRAJ; do

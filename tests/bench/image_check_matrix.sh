@@ -34,19 +34,6 @@ for f in $FAULTS; do
     { echo "bench: BENCH_FAULTS: '$f' is not side:M or up:M" >&2; exit 2; }
 done
 
-# A run folder over `cache` whose trajectory.tum is `traj` (report.json: mode and sources only).
-make_run() {
-  local run=$1 cache=$2 traj=$3
-  rm -rf "$run"
-  mkdir -p "$run"
-  python3 - "$run/report.json" "$(realpath "$cache")" <<'PY'
-import json, sys
-json.dump({"mode": "stereo-imu", "sources": {"dataset": sys.argv[2], "format": "kitti-raw",
-           "calib_files": [], "gnss_file": None}}, open(sys.argv[1], "w"), indent=2)
-PY
-  cp "$traj" "$run/trajectory.tum"
-}
-
 check() {
   local run=$1
   # shellcheck disable=SC2086
@@ -60,7 +47,7 @@ check_cell() {
   local f dir metres
   simulate_drive "$style" "$seed" "$start" "$cache" || { echo "$?" > "$cell/simulate_rc.txt"; return 0; }
   echo "bench: $style seed $seed: true poses" >&2
-  make_run "$cell/truth" "$cache" "$cache/groundtruth.tum"
+  python3 tests/bench/trajectory_run.py "$cell/truth" "$cache" "$cache/groundtruth.tum"
   check "$cell/truth"
   for f in $FAULTS; do
     dir="${f%%:*}" metres="${f#*:}"
@@ -68,7 +55,7 @@ check_cell() {
     python3 tests/bench/displace_poses.py "$cache/groundtruth.tum" "$cell/moved.tum" \
       "$FAULT_FROM" "$(awk -v a="$FAULT_FROM" -v b="$FAULT_S" 'BEGIN { print a + b }')" \
       "$dir" "$metres"
-    make_run "$cell/${dir}_${metres}" "$cache" "$cell/moved.tum"
+    python3 tests/bench/trajectory_run.py "$cell/${dir}_${metres}" "$cache" "$cell/moved.tum"
     check "$cell/${dir}_${metres}"
   done
   rm -f "$cell/moved.tum"
