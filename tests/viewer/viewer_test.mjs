@@ -6,13 +6,15 @@
 //   - draw non-background pixels in the 3-D view,
 //   - show the expected trajectories, and the expected number of points in its octree,
 //   - load and draw deeper octree levels when the camera moves in,
-//   - show a keyframe's panel (and its image, when the site has images) when one is clicked.
+//   - show a keyframe's panel (and its image, when the site has images) when one is clicked,
+//   - draw its tracks on the 2-D map (offline: the UTM grid) and the expected plots,
+//   - offer to colour the map by the image check's scores exactly when the site has them
+//     (--image-check), and colour it so.
 // Screenshots go to --shots. Prints one JSON line of figures; exits 1 on a failed check, 77 when
 // chromium is missing (ctest: skipped).
 //
-//   - draw its tracks on the 2-D map (offline: the UTM grid) and the expected plots.
 // node viewer_test.mjs --site DIR --shots DIR [--trajectories a,b] [--points N] [--keyframes]
-//                      [--plots N]
+//                      [--plots N] [--image-check]
 //                      [--chromium PATH] [--max-first-picture-ms MS]
 import { existsSync, mkdirSync } from 'node:fs';
 import { resolve } from 'node:path';
@@ -88,6 +90,23 @@ try {
     check(first.pointsTotal === Number(args.points), `octree points ${first.pointsTotal} (expected ${args.points})`);
   }
   await page.screenshot({ path: `${shots}/overview.png` });
+
+  // The map coloured by the image check's scores: offered only where the site has them, and then
+  // the points take colours they do not have by intensity.
+  const modes = await page.evaluate(() => window.gvioViewer.colorModes());
+  if (args['image-check']) {
+    check(modes.includes('image check'), `colour modes ${modes} include the image check`);
+    const grey = await page.evaluate(() => window.gvioViewer.pixelColors());
+    await page.evaluate(() => window.gvioViewer.setColorMode('image check'));
+    const scored = await page.evaluate(() => window.gvioViewer.pixelColors());
+    figures.image_check_coloured_pixels = [grey.coloured, scored.coloured];
+    check(scored.coloured > grey.coloured + 1000,
+      `coloured by the image check: ${scored.coloured} coloured pixels (by intensity ${grey.coloured})`);
+    await page.screenshot({ path: `${shots}/image_check.png` });
+    await page.evaluate(() => window.gvioViewer.setColorMode('intensity'));
+  } else {
+    check(!modes.includes('image check'), `colour modes ${modes}: no image check without its scores`);
+  }
 
   if (first.nodesTotal > 1) {
     // From far away only the top of the tree is drawn; in close to the densest leaf, deeper

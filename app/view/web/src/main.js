@@ -13,6 +13,7 @@ import {
   loopEdges,
   trajectoryLine,
 } from './layers.js';
+import { CheckScores } from './check_scores.js';
 import { PointOctree } from './octree.js';
 import { colorModes, makePointMaterial } from './point_material.js';
 import { buildPanel } from './ui.js';
@@ -67,6 +68,11 @@ class Viewer {
     if (s.points) {
       this.octree = new PointOctree(s.points, this.material, this.scene);
       this.octree.onLoad = () => this.requestRender();
+      // Set before any node loads: a node's arrays are freed once on the GPU.
+      if (s.consistency && s.consistency.t.length > 0) {
+        const scores = new CheckScores(s.consistency);
+        if (scores.size > 0) this.octree.scores = scores;
+      }
       const b = this.octree.root.bounds;
       this.material.uniforms.uHeightRange.value.set(b[2], b[5]);
       this.addLayer('dense points', null, true, undefined);
@@ -140,7 +146,12 @@ class Viewer {
   }
 
   setColorMode(mode) {
+    if (!colorModes.includes(mode) || (mode === 'image check' && !this.octree?.scores)) {
+      throw new Error(`no colour mode '${mode}' for this map`);
+    }
     this.material.uniforms.uColorMode.value = colorModes.indexOf(mode);
+    const select = document.getElementById('color-mode');
+    if (select) select.value = mode;
     this.requestRender();
   }
 
@@ -244,21 +255,37 @@ class Viewer {
     });
   }
 
-  // Pixels of the 3-D view that are not the background, drawn now.
-  nonBackgroundPixels() {
+  // The 3-D view's pixels, drawn now, counted by colour: grey, magenta and other colours (the
+  // background left out).
+  pixelColors() {
+    const px = this.readPixels();
+    const bg = [(kBackground >> 16) & 255, (kBackground >> 8) & 255, kBackground & 255];
+    const out = { grey: 0, magenta: 0, coloured: 0 };
+    for (let i = 0; i < px.length; i += 4) {
+      const [r, g, b] = [px[i], px[i + 1], px[i + 2]];
+      if (Math.abs(r - bg[0]) + Math.abs(g - bg[1]) + Math.abs(b - bg[2]) <= 6) continue;
+      if (Math.max(r, g, b) - Math.min(r, g, b) < 24) ++out.grey;
+      else if (r > 200 && b > 200 && g < 60) ++out.magenta;
+      else ++out.coloured;
+    }
+    return out;
+  }
+
+  readPixels() {
     this.draw();
     const gl = this.renderer.getContext();
-    const w = gl.drawingBufferWidth,
-      h = gl.drawingBufferHeight;
-    const pixels = new Uint8Array(4 * w * h);
-    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, pixels);
-    const [r, g, b] = [(kBackground >> 16) & 255, (kBackground >> 8) & 255, kBackground & 255];
-    let n = 0;
-    for (let i = 0; i < pixels.length; i += 4) {
-      if (Math.abs(pixels[i] - r) + Math.abs(pixels[i + 1] - g) + Math.abs(pixels[i + 2] - b) > 6) ++n;
-    }
-    return n;
+    const pixels = new Uint8Array(4 * gl.drawingBufferWidth * gl.drawingBufferHeight);
+    gl.readPixels(0, 0, gl.drawingBufferWidth, gl.drawingBufferHeight, gl.RGBA, gl.UNSIGNED_BYTE,
+      pixels);
+    return pixels;
   }
+
+  // Pixels of the 3-D view that are not the background, drawn now.
+  nonBackgroundPixels() {
+    const c = this.pixelColors();
+    return c.grey + c.magenta + c.coloured;
+  }
+
 }
 
 function testInterface(viewer) {
@@ -289,6 +316,9 @@ function testInterface(viewer) {
       viewer.requestRender();
     },
     nonBackgroundPixels: () => viewer.nonBackgroundPixels(),
+    setColorMode: (mode) => viewer.setColorMode(mode),
+    colorModes: () => [...document.querySelectorAll('#color-mode option')].map((o) => o.value),
+    pixelColors: () => viewer.pixelColors(),
     showKeyframes(on) {
       return viewer.setLayerVisible(viewer.keyframeLayer, on);
     },

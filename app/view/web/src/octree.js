@@ -33,6 +33,7 @@ export class PointOctree {
     this.deepestDrawn = -1;
     this.onLoad = () => {};
     this.failed = [];
+    this.scores = null; // a CheckScores: each loaded point gets its image-check code
   }
 
   get root() {
@@ -118,10 +119,12 @@ export class PointOctree {
   makeObject(node, n, bytes) {
     const buffer = bytes.buffer; // a fresh buffer of its own (decodeBase64)
     const geometry = new THREE.BufferGeometry();
-    geometry.setAttribute(
-      'position',
-      new THREE.BufferAttribute(new Uint16Array(buffer, 0, 3 * n), 3, true),
-    );
+    const quantised = new Uint16Array(buffer, 0, 3 * n);
+    geometry.setAttribute('position', new THREE.BufferAttribute(quantised, 3, true));
+    if (this.scores) {
+      const codes = this.scores.codesOf(quantised, n, node.cube);
+      geometry.setAttribute('score', new THREE.BufferAttribute(codes, 1));
+    }
     geometry.setAttribute('drive', new THREE.BufferAttribute(new Uint16Array(buffer, 6 * n, n), 1));
     geometry.setAttribute(
       'intensity',

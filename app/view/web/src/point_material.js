@@ -3,12 +3,14 @@
 import * as THREE from 'three';
 import { drivePalette } from './colors.js';
 
-export const colorModes = ['intensity', 'height', 'drive', 'kind'];
+// 'image check' needs the image check's scores (octree.scores): the page offers it only then.
+export const colorModes = ['intensity', 'height', 'drive', 'kind', 'image check'];
 
 const vertexShader = /* glsl */ `
 in float drive;
 in float intensity;
 in float kind;
+in float score;  // check_scores.js: 0 none, 1..254 ZNCC 0..1, 255 flagged
 uniform float uPointSize;
 uniform int uColorMode;
 uniform vec2 uHeightRange;
@@ -48,8 +50,16 @@ void main() {
     vColor = turbo((world.z - uHeightRange.x) / max(uHeightRange.y - uHeightRange.x, 1e-3));
   } else if (uColorMode == 2) {
     vColor = uPalette[int(mod(drive, ${drivePalette.length}.0))];
-  } else {
+  } else if (uColorMode == 3) {
     vColor = sparse ? vec3(0.9, 0.2, 0.2) : vec3(0.6, 0.6, 0.65) * (0.4 + 0.6 * intensity);
+  } else if (score < 0.5) {
+    vColor = vec3(0.12 + 0.3 * intensity);  // no checked keyframe near: dim grey
+  } else if (score > 254.5) {
+    vColor = vec3(1.0, 0.0, 1.0);  // flagged: magenta, as the keyframe markers
+  } else {
+    // ZNCC from red (0) through yellow to green (1), as the keyframe markers.
+    float x = (score - 1.0) / 253.0;
+    vColor = vec3(min(1.0, 2.0 - 2.0 * x), min(1.0, 2.0 * x), 0.05);
   }
 }
 `;

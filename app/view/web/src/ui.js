@@ -68,7 +68,10 @@ export function buildPanel(root, viewer, scene) {
       id: 'color-mode',
       onchange: () => viewer.setColorMode(select.value),
     });
-    for (const m of colorModes) select.append(el('option', { value: m, text: `colour by ${m}` }));
+    for (const m of colorModes) {
+      if (m === 'image check' && !viewer.octree.scores) continue;
+      select.append(el('option', { value: m, text: `colour by ${m}` }));
+    }
     panel.append(select);
     const size = el('input', { type: 'range', min: 1, max: 8, step: 0.5, value: 2 });
     size.addEventListener('input', () => viewer.setPointSize(Number(size.value)));
