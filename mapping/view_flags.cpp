@@ -110,10 +110,9 @@ Similar similarViews(const std::vector<double>& residual, const std::vector<doub
 
 // One comparison (with the local medians or the drive's): per view the shift and spread tau that
 // views like it show (similarViews; tau never below the drive's; the drive's tau and no shift
-// where the view has no covariate), the
-// scale of its residual d = max(sqrt(tau^2 + se^2), min_flag_sigma), the standardised residual
-// z = (v - ref - shift) / d, and the robust spread of z over the drive (at least 1: a drive is
-// never trusted to be tighter than its own errors say).
+// where too few views are like it), the scale of its residual d = max(sqrt(tau^2 + se^2),
+// min_flag_sigma), the standardised residual z = (v - ref - shift) / d, and the robust spread of
+// z over the drive (at least 1: a drive is never trusted to be tighter than its own errors say).
 struct Comparison {
   std::vector<double> d, z, shift;
   double tau = kNan, z_spread = kNan;
