@@ -1,13 +1,16 @@
-// The viewer's benchmark in the real browser (Debian's chromium, headless, software GL): from
+// The viewer's benchmark in the real browser (Debian's chromium, headless, software GL: Mesa's
+// llvmpipe, or SwiftShader with --gl swiftshader; tests/viewer/chromium_gl.mjs): from
 // navigation to the first picture, and the browser's memory (every chromium process's resident
 // proportional set, summed) once the overview has settled and
 // after moving in close. Prints one JSON line.
 // node viewer_bench.mjs --site DIR [--web app/view/web] [--chromium PATH] [--shot FILE]
+//                       [--gl llvmpipe|swiftshader]
 import { execFileSync } from 'node:child_process';
 import { readFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { createRequire } from 'node:module';
+import { chromiumArgs, rendererOf } from '../viewer/chromium_gl.mjs';
 
 const args = Object.fromEntries(
   process.argv.slice(2).reduce((acc, a, i, all) => {
@@ -37,14 +40,19 @@ function browserPssMb(marker) {
   return Math.round(kb / 1024);
 }
 
+const gl = args.gl ?? 'llvmpipe';
 const browser = await chromium.launch({ executablePath: args.chromium ?? '/usr/bin/chromium',
-  args: ['--no-sandbox'] });
+  args: chromiumArgs(gl) });
 const marker = 'playwright_chromiumdev_profile';
 const figures = {};
 try {
   const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
   await page.goto('about:blank');
   figures.pss_blank_page_mb = browserPssMb(marker);
+  figures.renderer = await rendererOf(page);
+  if (!figures.renderer.toLowerCase().includes(gl)) {
+    throw new Error(`WebGL renders with ${figures.renderer}, not ${gl}`);
+  }
   const errors = [];
   page.on('pageerror', (e) => errors.push(String(e)));
   await page.goto(pathToFileURL(resolve(args.site, 'index.html')).href);

@@ -49,7 +49,7 @@ for label, line in (("demo run", sys.argv[1]), (f"merged map, {int(sys.argv[3]) 
     b = json.loads(browser)
     per_m = re.search(r"\(([0-9.]+) s per million", cost)
     rows.append((label, b, per_m.group(1) if per_m else "n/a"))
-print("The viewer in headless chromium (software GL): time from navigation to the first picture, and "
+print(f"The viewer in headless chromium (software GL: {rows[0][1].get('renderer', 'unknown')}): time from navigation to the first picture, and "
       "the browser's memory (proportional set size of all its processes; an empty page holds the "
       "first figure); targets: demo first picture <= 2 s, 50 M points <= 5 s and <= 500 MB, "
       "octree <= 0.2 s per million points")

@@ -1,6 +1,6 @@
-// Issue 62: gvio view's page in a real browser (Debian's chromium, headless, software GL),
-// driven by playwright-core (pinned in app/view/web/package-lock.json). Opened from its folder
-// (file://), the page must
+// Issue 62: gvio view's page in a real browser (Debian's chromium, headless, software GL: Mesa's
+// llvmpipe, or SwiftShader with --gl swiftshader; chromium_gl.mjs), driven by playwright-core
+// (pinned in app/view/web/package-lock.json). Opened from its folder (file://), the page must
 //   - load with no console error and no failed data file,
 //   - draw its first picture (the root node and the layers) and report when (first_picture_ms),
 //   - draw non-background pixels in the 3-D view,
@@ -15,11 +15,12 @@
 //
 // node viewer_test.mjs --site DIR --shots DIR [--trajectories a,b] [--points N] [--keyframes]
 //                      [--plots N] [--image-check]
-//                      [--chromium PATH] [--max-first-picture-ms MS]
+//                      [--chromium PATH] [--max-first-picture-ms MS] [--gl llvmpipe|swiftshader]
 import { existsSync, mkdirSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { createRequire } from 'node:module';
+import { chromiumArgs, rendererOf } from './chromium_gl.mjs';
 
 const args = Object.fromEntries(
   process.argv.slice(2).reduce((acc, a, i, all) => {
@@ -44,11 +45,8 @@ const check = (ok, what) => {
 
 const shots = resolve(args.shots);
 mkdirSync(shots, { recursive: true });
-const browser = await chromium.launch({
-  executablePath: chromiumPath,
-  args: ['--no-sandbox', '--use-gl=angle', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-    '--allow-file-access-from-files'],
-});
+const gl = args.gl ?? 'llvmpipe';
+const browser = await chromium.launch({ executablePath: chromiumPath, args: chromiumArgs(gl) });
 const figures = {};
 try {
   const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
@@ -58,6 +56,8 @@ try {
   page.on('requestfailed', (r) => errors.push(`failed: ${r.url()}`));
   const url = pathToFileURL(resolve(args.site, 'index.html')).href;
   await page.goto(url);
+  figures.renderer = await rendererOf(page);
+  check(figures.renderer.toLowerCase().includes(gl), `WebGL renders with ${gl}: ${figures.renderer}`);
   await page.waitForFunction(() => window.gvioViewer?.stats().firstPictureMs != null, null, {
     timeout: 30000,
   });
