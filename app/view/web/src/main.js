@@ -285,7 +285,6 @@ class Viewer {
     const c = this.pixelColors();
     return c.grey + c.magenta + c.coloured;
   }
-
 }
 
 function testInterface(viewer) {
