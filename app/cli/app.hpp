@@ -23,6 +23,18 @@ struct CommonOptions {
   [[nodiscard]] ProgressStyle progressStyle() const;
 };
 
+// Checks an unsigned option's text: a whole number >= 0. CLI11 would convert "-1" into an
+// unsigned option by wrapping it into a huge count; this refuses it in one line instead.
+inline CLI::Validator countValidator() {
+  return CLI::Validator(
+      [](std::string& text) {
+        const bool digits =
+            !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+        return digits ? std::string() : "'" + text + "' is not a whole number >= 0";
+      },
+      "COUNT");
+}
+
 // --config FILE and --set key=value, on the subcommands that take configuration.
 struct ConfigOptions {
   std::optional<std::string> file;

@@ -170,7 +170,8 @@ Command addConsistencyCommand(CLI::App& app, const CommonOptions& common) {
   sub->add_option("--dataset", ic.dataset,
                   "--images: the dataset, if it moved since the run (default: report.json's)");
   sub->add_option("--every", ic.every, "--images: check every n-th map keyframe")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(countValidator());
   sub->add_option("--at", ic.at_s, "--images: check only the keyframe nearest T s into the drive");
   sub->add_option("--from", ic.from_s, "--images: check only keyframes from S s into the drive");
   sub->add_option("--to", ic.to_s, "--images: ... up to S s into the drive");
@@ -179,7 +180,8 @@ Command addConsistencyCommand(CLI::App& app, const CommonOptions& common) {
       ->capture_default_str();
   sub->add_option("--worst", ic.worst_images,
                   "--images: side-by-side images of this many worst keyframes")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(countValidator());
   sub->add_option("--flag-sigmas", ic.check.score.flag_sigmas,
                   "--images: flag a keyframe whose ZNCC lies this many of its sigmas below what "
                   "is typical of its stretch of the drive")
@@ -190,7 +192,8 @@ Command addConsistencyCommand(CLI::App& app, const CommonOptions& common) {
   sub->add_option("--similar-views", ic.check.score.similar_views,
                   "--images: judge a keyframe against this many keyframes whose map points in "
                   "view lie at the most similar depths (0: against the whole drive alike)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(countValidator());
   sub->add_flag("--no-revisits", ic.no_revisits,
                 "--images: do not check keyframes at revisits against the other passes' map");
   sub->add_option("--json", o->json, "Write the metrics as JSON");

@@ -203,6 +203,15 @@ TEST_F(CliConsistencyImages, OneKeyframeAtATimeAndBadRequests) {
   r = runGvio(fmt::format("consistency --run {} --images --exclude -1", quoted(run("truth"))));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr("--exclude"));
+  // Counts are unsigned: -1 is refused, not wrapped into a huge count.
+  for (const char* count : {"--every", "--worst", "--similar-views"}) {
+    r = runGvio(fmt::format("consistency --run {} --images {} -1", quoted(run("truth")), count));
+    EXPECT_EQ(r.exit_code, 2) << count;
+    EXPECT_THAT(r.err, HasSubstr(count));
+  }
+  r = runGvio(fmt::format("consistency --run {} --images --similar-views 3", quoted(run("truth"))));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("similar_views must be 0 (off) or >= min_views_to_flag"));
   r = runGvio(fmt::format("consistency --run {} --images --flag-sigmas 0", quoted(run("truth"))));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr("flag_sigmas must be > 0"));
