@@ -65,7 +65,7 @@ try {
     page.waitForFunction(
       () => {
         const s = window.gvioViewer.stats();
-        return s.loading === 0 && s.frames > 0;
+        return s.settled && s.frames > 0;
       },
       null,
       { timeout: 60000 },

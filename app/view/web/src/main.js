@@ -303,6 +303,7 @@ function testInterface(viewer) {
         nodesTotal: o ? o.nodes.length : 0,
         nodesLoaded: o ? o.loadedNodes : 0,
         loading: o ? o.loading : 0,
+        settled: o ? o.settled : true,
         deepestDrawn: o ? o.deepestDrawn : -1,
         frames: viewer.frames,
         firstPictureMs: viewer.firstPictureMs,

@@ -2,7 +2,9 @@
 // comes near them and shown while their points are sparser on screen than minSpacingPx, nearest
 // and largest first, within a point budget (Schuetz 2016, "Potree", sec. 4: nodes by projected
 // size in a priority queue). Loaded nodes that are not drawn are dropped, oldest first, once the
-// page holds twice the budget.
+// page holds twice the budget. Loading is fed from the last frame's wish list as each load
+// ends, not only when a frame is drawn: with software GL a frame of millions of points takes
+// half a second, and tying loads to frames held the view in close to a fifth of its points.
 import * as THREE from 'three';
 import { decodeBase64, loadDataScript } from './data.js';
 
@@ -26,6 +28,8 @@ export class PointOctree {
     this.pointBudget = 3_000_000;
     this.minSpacingPx = 3;
     this.loading = 0;
+    this.queue = []; // nodes wanted by the last update, most wanted first
+    this.stale = false; // a node loaded since the last update
     this.frame = 0;
     this.loadedPoints = 0;
     this.drawnPoints = 0;
@@ -44,6 +48,7 @@ export class PointOctree {
   // and starts loading the nodes wanted next.
   update(camera, heightPx) {
     ++this.frame;
+    this.stale = false;
     const frustum = new THREE.Frustum().setFromProjectionMatrix(
       new THREE.Matrix4().multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse),
     );
@@ -88,11 +93,22 @@ export class PointOctree {
     this.drawnNodes = drawnNodes;
     this.deepestDrawn = deepest;
     wanted.sort((a, b) => b[0] - a[0]);
-    for (const [, node] of wanted) {
-      if (this.loading >= kMaxLoads) break;
-      this.load(node);
-    }
+    this.queue = wanted.map(([, node]) => node);
+    this.startLoads();
     this.evict();
+  }
+
+  startLoads() {
+    while (this.loading < kMaxLoads && this.queue.length > 0) {
+      const node = this.queue.shift();
+      if (node.state === 'none') this.load(node);
+    }
+  }
+
+  // Nothing loading, nothing more wanted, and the last update saw every load: the view shows
+  // what it will show until the camera moves.
+  get settled() {
+    return this.loading === 0 && this.queue.length === 0 && !this.stale;
   }
 
   load(node) {
@@ -112,6 +128,8 @@ export class PointOctree {
       })
       .finally(() => {
         --this.loading;
+        this.stale = true;
+        this.startLoads();
         this.onLoad(node);
       });
   }
