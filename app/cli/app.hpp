@@ -24,15 +24,15 @@ struct CommonOptions {
 };
 
 // Checks an unsigned option's text: a whole number >= 0. CLI11 would convert "-1" into an
-// unsigned option by wrapping it into a huge count; this refuses it in one line instead.
-inline CLI::Validator countValidator() {
+// unsigned option by wrapping it into a huge count (or seed); this refuses it in one line instead.
+inline CLI::Validator countValidator(const std::string& name = "COUNT") {
   return CLI::Validator(
       [](std::string& text) {
         const bool digits =
             !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
         return digits ? std::string() : "'" + text + "' is not a whole number >= 0";
       },
-      "COUNT");
+      name);
 }
 
 // --config FILE and --set key=value, on the subcommands that take configuration.

@@ -91,7 +91,9 @@ Command addRunCommand(CLI::App& app, const CommonOptions& common) {
                   "GNSS fixes from this file instead of the dataset's (any format): NMEA 0183, an "
                   "RTKLIB solution (.pos: GPST/UTC, lat/lon/height or ECEF) or CSV "
                   "(#timestamp [ns],lat_deg,lon_deg,height_m,sigma_h_m,sigma_v_m)");
-  sub->add_option("--seed", opt->seed, "Random seed of --gnss-noise")->capture_default_str();
+  sub->add_option("--seed", opt->seed, "Random seed of --gnss-noise")
+      ->capture_default_str()
+      ->check(countValidator("SEED"));
   sub->add_option("--out", opt->out, "Run folder (created if missing; files in it are replaced)")
       ->capture_default_str();
   sub->add_option("--two-pass", opt->two_pass,

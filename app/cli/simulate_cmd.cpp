@@ -137,10 +137,12 @@ Command addSimulateCommand(CLI::App& app, const CommonOptions& common) {
   sub->add_option("--world-style", o->world_style,
                   "street (default), open_road, sparse_texture, repetitive or vegetation "
                   "(overrides sim.world_style)");
-  sub->add_option("--seed", o->request.seed, "Random seed: same seed, byte-identical output");
+  sub->add_option("--seed", o->request.seed, "Random seed: same seed, byte-identical output")
+      ->check(countValidator("SEED"));
   sub->add_option("--world-seed", o->request.world_seed,
                   "Seed of the street world alone (default: --seed): drives of one route with one "
-                  "world seed and different --seed see the same streets with their own noise");
+                  "world seed and different --seed see the same streets with their own noise")
+      ->check(countValidator("SEED"));
   sub->add_option("--out", o->out, "Output folder (must be empty unless --force)")->required();
   sub->add_flag("--force", o->request.force,
                 "Overwrite the simulator's files in a non-empty output folder");

@@ -28,5 +28,22 @@ TEST(CliSimulateWorldSeed, OneWorldSeedGivesOneWorldWhateverTheNoiseSeed) {
   EXPECT_NE(readText(c / "sim.yaml").find("world_seed: 2"), std::string::npos);
 }
 
+// Seeds are unsigned: "-1" is refused in one line, not wrapped into 2^64 - 1 and run.
+TEST(CliSimulateWorldSeed, NegativeSeedsAreRefused) {
+  const TempDir dir("cli_simulate_negative_seed");
+  for (const char* seed : {"--seed", "--world-seed"}) {
+    const CommandResult r = runGvio(
+        fmt::format("-q simulate --trajectory {}/assets/demo/drive.tum --seconds 1 {} -1 --out {}",
+                    GVIO_SOURCE_DIR, seed, quoted(dir.path() / "s")));
+    EXPECT_EQ(r.exit_code, 2) << seed;
+    EXPECT_NE(r.err.find(seed), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("not a whole number"), std::string::npos) << r.err;
+  }
+  const CommandResult r =
+      runGvio(fmt::format("-q run --dataset {} --gnss-noise spp --seed -1", quoted(dir.path())));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--seed"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace gvio::test
