@@ -4,7 +4,8 @@
 # APE RMSE, RPE per 100 m), the final trajectory (trajectory.tum: loop-closed, fused) with no
 # alignment against the ENU truth (SE(3) without GNSS) and its revisit consistency
 # (`gvio eval --revisits 5`), and prints tables with ms/frame per stage (mean, p95), GNSS cost per
-# fix, the map stage, loop closure and peak RSS from report.json.
+# fix, the map stage, loop closure, the whole run's and each stage's wall time and peak RSS from
+# report.json.
 # A mode is VIO_MODE:GNSS[:noloops] (GNSS off|kf|graph; noloops: loops.enabled=false, today's
 # behaviour before loop closure). BENCH_SET adds --set options to every run. A benchmark, not a
 # test: nothing asserts a timing.
@@ -158,11 +159,22 @@ for mode in modes:
               f'| {lp["ms_features_per_keyframe"]["mean"]:.2f} | {solve} |')
     else:
         print(f"| {mode} | {ape} | {rev} | {map_rev} | off | - | - | - |")
+
+# The whole command (report.json's run_wall_s) and each stage's wall time (by name).
+print()
+print("| mode | frames | run wall time (s) | wall time per stage (s) | peak RSS (MiB) |")
+print("| --- | --- | --- | --- | --- |")
+for mode in modes:
+    rep = json.load(open(os.path.join(out, mode.replace(":", "_"), "report.json")))
+    stages = ", ".join(f"{k} {v:.1f}" for k, v in rep.get("stage_wall_s", {}).items() if v >= 0.05)
+    print(f'| {mode} | {rep["counts"]["frames"]} | {rep["run_wall_s"]:.1f} | {stages} '
+          f'| {rep["peak_rss_mb"]:.0f} |')
 PY
 
 # The fused runs' floor on this draw: the error of the best constant offset the fixes allow with the
 # trajectory's shape known exactly (tests/bench/gnss_offset_floor.py): what a fusion of these
 # fixes can expect to reach at best.
+echo
 for mode in $MODES; do
   run="$OUT/${mode//:/_}"
   if [ -f "$run/georef.json" ] && [ -f "$run/gnss_fixes.csv" ]; then
