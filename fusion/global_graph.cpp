@@ -181,7 +181,7 @@ class Graph {
         // has its own receiver (or its own day).
         const Eigen::Matrix3d A = Eigen::Matrix3d::Identity() / (config_.bias_ratio * f.sigma_h_m);
         problem.AddResidualBlock(new ceres::NormalPrior(A, Eigen::Vector3d::Zero()), nullptr,
-                                 biases_[0].data());
+                                 biases_[k].data());
         continue;
       }
       const double dt = static_cast<double>(f.t_ns - fixes_[k - 1].t_ns) * 1e-9;

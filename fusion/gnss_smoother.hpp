@@ -11,7 +11,8 @@
 //   b_{k+1} = phi b_k + w_k, phi = exp(-dt / tau), var(w_k) = sigma_b^2 (1 - phi^2)
 // (Groves 2013, "Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems",
 // 2nd ed., eq. 14.74 / App. I), with the fix p_fix = p_antenna + b + white noise. Without it a
-// correlated error is taken for truth by every fix it touches.
+// correlated error is taken for truth by every fix it touches. One chain per fix quality: an RTK
+// fixed, a float and a single-point solution are different error processes.
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <map>

@@ -311,6 +311,35 @@ TEST(GlobalGraph, LoopsBetweenDrivesMakeTwoDrivesAgree) {
   EXPECT_GT(rmse(d.truth, mixed.T), 3.0 * rmse(d.truth, joint.T));
 }
 
+// Each drive's receiver bias starts from its own stationary prior: with no loop between them, a
+// drive solved beside another comes out as it does alone (the second drive's bias chain once had
+// no prior of its own, its prior landing on the first drive's first bias).
+TEST(GlobalGraph, DrivesWithoutLoopsAreSolvedAsIfAlone) {
+  const TwoDrives d = makeTwoDrives(makeLoopWorld());
+  const std::size_t first1 = static_cast<std::size_t>(
+      std::find_if(d.nodes.begin(), d.nodes.end(), [](const GraphNode& n) { return n.segment; }) -
+      d.nodes.begin());
+  std::vector<GraphNode> alone_nodes(d.nodes.begin() + static_cast<std::ptrdiff_t>(first1),
+                                     d.nodes.end());
+  for (GraphNode& n : alone_nodes) n.segment = 0;
+  std::vector<GraphFix> alone_fixes;
+  for (GraphFix f : d.fixes) {
+    if (f.node < first1) continue;
+    f.node -= first1;
+    alone_fixes.push_back(f);
+  }
+  ASSERT_GT(alone_fixes.size(), 10U);
+  const GlobalGraphResult both = solveGlobalGraph(d.nodes, d.fixes, {}, true, graphConfig());
+  const GlobalGraphResult alone =
+      solveGlobalGraph(alone_nodes, alone_fixes, {}, true, graphConfig());
+  double worst = 0.0;
+  for (std::size_t k = 0; k < alone_nodes.size(); ++k) {
+    worst = std::max(worst, (both.T[first1 + k].translation() - alone.T[k].translation()).norm());
+  }
+  std::cout << "drive 2 beside drive 1 against alone: at most " << worst << " m apart\n";
+  EXPECT_LT(worst, 1e-3);
+}
+
 TEST(GlobalGraph, ASegmentWithoutFixesOrLoopsHoldsItsFirstNode) {
   TwoDrives d = makeTwoDrives(makeLoopWorld());
   std::erase_if(d.fixes, [&](const GraphFix& f) { return d.nodes[f.node].segment == 1; });
