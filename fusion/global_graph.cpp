@@ -3,6 +3,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <memory>
 
 #include <ceres/loss_function.h>
@@ -165,6 +166,7 @@ class Graph {
 
   void addFixes(ceres::Problem& problem) {
     const bool with_bias = config_.bias_ratio > 0.0;
+    std::map<int, std::size_t> last_of_quality;  // in the current drive
     for (std::size_t k = 0; k < fixes_.size(); ++k) {
       const GraphFix& f = fixes_[k];
       double* pose = poses_[f.node].data();
@@ -176,18 +178,25 @@ class Graph {
       problem.AddResidualBlock(
           new GnssBiasedPositionFactor(f.q_b, f.p_enu, f.sigma_h_m, f.sigma_v_m), &huber_, pose,
           biases_[k].data());
-      if (k == 0 || nodes_[f.node].segment != nodes_[fixes_[k - 1].node].segment) {
-        // The bias's stationary distribution at a drive's first fix: N(0, sigma^2 I); each drive
-        // has its own receiver (or its own day).
-        const Eigen::Matrix3d A = Eigen::Matrix3d::Identity() / (config_.bias_ratio * f.sigma_h_m);
+      // One bias chain per drive and fix quality (as the smoother: an RTK fixed, a float and a
+      // single-point solution are different error processes); each drive has its own receiver
+      // (or its own day).
+      const std::uint32_t segment = nodes_[f.node].segment;
+      if (k == 0 || segment != nodes_[fixes_[k - 1].node].segment) last_of_quality.clear();
+      const auto last = last_of_quality.find(f.quality);
+      const double sigma_b = config_.bias_ratio * f.sigma_h_m;
+      if (last == last_of_quality.end()) {
+        // The bias's stationary distribution at a chain's first fix: N(0, sigma^2 I).
+        const Eigen::Matrix3d A = Eigen::Matrix3d::Identity() / sigma_b;
         problem.AddResidualBlock(new ceres::NormalPrior(A, Eigen::Vector3d::Zero()), nullptr,
                                  biases_[k].data());
-        continue;
+      } else {
+        const std::size_t j = last->second;
+        const double dt = static_cast<double>(f.t_ns - fixes_[j].t_ns) * 1e-9;
+        problem.AddResidualBlock(new GaussMarkovFactor(dt, config_.bias_tau_s, sigma_b), nullptr,
+                                 biases_[j].data(), biases_[k].data());
       }
-      const double dt = static_cast<double>(f.t_ns - fixes_[k - 1].t_ns) * 1e-9;
-      problem.AddResidualBlock(
-          new GaussMarkovFactor(dt, config_.bias_tau_s, config_.bias_ratio * f.sigma_h_m), nullptr,
-          biases_[k - 1].data(), biases_[k].data());
+      last_of_quality[f.quality] = k;
     }
   }
 

@@ -111,7 +111,7 @@ void GnssFusion::Impl::noteAccepted(std::int64_t t_ns) {
 
 void GnssFusion::Impl::noteOutcome(const Pair& pair, bool used) {
   stats.fixes.push_back({pair.t_ns, pair.p_enu, used ? FixStatus::kUsed : FixStatus::kRejected,
-                         pair.fix.sigma_h_m, pair.fix.sigma_v_m});
+                         pair.fix.sigma_h_m, pair.fix.sigma_v_m, pair.fix.quality});
   if (used) {
     noteAccepted(pair.t_ns);
   } else {
@@ -270,7 +270,7 @@ void GnssFusion::Impl::processFix(const GnssFix& fix) {
   if (!T_w_b) {
     ++stats.fixes_unmatched;
     stats.fixes.push_back({fix.t_ns, enu.toEnu({fix.lat_deg, fix.lon_deg, fix.h_ellipsoid_m}),
-                           FixStatus::kUnmatched, fix.sigma_h_m, fix.sigma_v_m});
+                           FixStatus::kUnmatched, fix.sigma_h_m, fix.sigma_v_m, fix.quality});
     return;
   }
   Pair pair{fix.t_ns, *T_w_b, enu.toEnu({fix.lat_deg, fix.lon_deg, fix.h_ellipsoid_m}), fix};
@@ -322,7 +322,7 @@ void GnssFusion::finish() {
   }
   for (const Impl::Pair& p : s.alignment_pairs) {
     s.stats.fixes.push_back(
-        {p.t_ns, p.p_enu, FixStatus::kUnaligned, p.fix.sigma_h_m, p.fix.sigma_v_m});
+        {p.t_ns, p.p_enu, FixStatus::kUnaligned, p.fix.sigma_h_m, p.fix.sigma_v_m, p.fix.quality});
   }
   s.alignment_pairs.clear();
   if (s.config.mode == FusionMode::kKf && s.config.kf.learn_noise) {

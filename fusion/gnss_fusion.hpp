@@ -86,6 +86,7 @@ struct FixOutcome {
   Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();  // the antenna position the fix reports
   FixStatus status = FixStatus::kUsed;
   double sigma_h_m = 0.0, sigma_v_m = 0.0;  // as the fix reports them
+  int quality = 1;                          // NMEA GGA fix quality (RTK fixed 4, float 5, ...)
 };
 
 struct FusionStats {

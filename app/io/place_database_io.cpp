@@ -19,7 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr std::string_view kMagic = "GVIOKFDB";
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;  // 2: a fix quality per fix
 constexpr std::size_t kDescriptorBytes = 32;
 constexpr std::size_t kThumbnail =
     static_cast<std::size_t>(mapping::kThumbnailWidth) * mapping::kThumbnailHeight;
@@ -169,7 +169,7 @@ void readKeyframe(Reader& r, mapping::PlaceDatabase& db) {
   db.T_vio.push_back(T_vio);
 }
 
-void readFix(Reader& r, mapping::PlaceDatabase& db) {
+void readFix(Reader& r, mapping::PlaceDatabase& db, std::uint32_t version) {
   fusion::GraphFix f;
   const auto node = r.get<std::uint64_t>();
   if (node >= db.keyframes.size()) r.fail("a fix on a keyframe that does not exist");
@@ -181,6 +181,10 @@ void readFix(Reader& r, mapping::PlaceDatabase& db) {
   f.sigma_h_m = r.finite();
   f.sigma_v_m = r.finite();
   if (!(f.sigma_h_m > 0.0 && f.sigma_v_m > 0.0)) r.fail("a fix sigma that is not > 0");
+  if (version >= 2) {
+    f.quality = r.get<std::int32_t>();
+    if (f.quality < 0 || f.quality > 9) r.fail("a fix quality that is not 0..9");
+  }
   db.fixes.push_back(f);
 }
 
@@ -228,6 +232,7 @@ void writePlaceDatabase(const fs::path& file, const mapping::PlaceDatabase& db) 
     for (int a = 0; a < 3; ++a) w.put<double>(f.p_enu(a));
     w.put<double>(f.sigma_h_m);
     w.put<double>(f.sigma_v_m);
+    w.put<std::int32_t>(f.quality);
   }
   for (const fusion::GraphLoop& l : db.loops) {
     w.put<std::uint64_t>(l.i);
@@ -248,7 +253,8 @@ mapping::PlaceDatabase parsePlaceDatabase(const std::string& bytes, const fs::pa
   if (bytes.size() < kMagic.size()) r.fail("not a gvio keyframe database (too short)");
   r.copy(magic, sizeof(magic));
   if (std::string_view(magic, sizeof(magic)) != kMagic) r.fail("not a gvio keyframe database");
-  if (r.get<std::uint32_t>() != kVersion) r.fail("a version this gvio does not read");
+  const auto version = r.get<std::uint32_t>();
+  if (version < 1 || version > kVersion) r.fail("a version this gvio does not read");
   mapping::PlaceDatabase db;
   db.has_imu = (r.get<std::uint32_t>() & 1U) != 0;
   CameraModel& cam = db.camera;
@@ -268,8 +274,8 @@ mapping::PlaceDatabase parsePlaceDatabase(const std::string& bytes, const fs::pa
   // The smallest record of each kind bounds the counts before anything is allocated.
   const std::size_t n_kf = r.count(keyframes, 8 + 24 * 8 + 3 * 8 + 3 * 4);
   for (std::size_t k = 0; k < n_kf; ++k) readKeyframe(r, db);
-  const std::size_t n_fix = r.count(fixes, 2 * 8 + 8 * 8);
-  for (std::size_t k = 0; k < n_fix; ++k) readFix(r, db);
+  const std::size_t n_fix = r.count(fixes, 2 * 8 + 8 * 8 + (version >= 2 ? 4 : 0));
+  for (std::size_t k = 0; k < n_fix; ++k) readFix(r, db, version);
   const std::size_t n_loop = r.count(loops, 2 * 8 + 48 * 8);
   for (std::size_t k = 0; k < n_loop; ++k) readLoop(r, db);
   if (r.left() != 0) r.fail("bytes after the last record");

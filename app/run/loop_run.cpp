@@ -102,6 +102,7 @@ std::vector<fusion::GraphFix> graphFixes(const std::vector<fusion::GraphNode>& n
     g.p_enu = f.p_enu;
     g.sigma_h_m = f.sigma_h_m;
     g.sigma_v_m = f.sigma_v_m;
+    g.quality = f.quality;
     fixes.push_back(g);
   }
   return fixes;

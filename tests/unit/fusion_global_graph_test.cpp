@@ -340,6 +340,48 @@ TEST(GlobalGraph, DrivesWithoutLoopsAreSolvedAsIfAlone) {
   EXPECT_LT(worst, 1e-3);
 }
 
+// An RTK receiver between float (a metre off that persists) and fixed (centimetres): each quality
+// has its own bias chain, so the fixed epochs' nodes are fused to their centimetres (the
+// smoother's GnssSmoother.EachFixQualityHasItsOwnBias, for the global graph).
+TEST(GlobalGraph, EachFixQualityHasItsOwnBias) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  std::vector<GraphNode> nodes;
+  std::vector<GraphFix> fixes;
+  for (int k = 0; k < 1000; ++k) {  // 200 s at 5 Hz, 10 m/s on a gentle curve
+    const double t = 0.2 * k;
+    GraphNode n;
+    n.t_ns = static_cast<std::int64_t>(k) * 200'000'000;
+    n.T_w_b.linear() = odometry::expSo3(Eigen::Vector3d(0, 0, 0.005 * t));
+    n.T_w_b.translation() = Eigen::Vector3d(10.0 * t, 0.025 * t * t, 0.0);
+    n.T_init = n.T_w_b;  // an exact VIO in ENU
+    nodes.push_back(n);
+    const bool fixed = t >= 60.0 && t < 140.0;
+    const Eigen::Vector3d float_bias =
+        t < 60.0 ? Eigen::Vector3d(0.8, -0.6, 0.3) : Eigen::Vector3d(-0.5, 0.7, -0.2);
+    GraphFix f;
+    f.node = static_cast<std::size_t>(k);
+    f.t_ns = n.t_ns;
+    f.p_enu = n.T_w_b.translation() + (fixed ? Eigen::Vector3d::Zero() : float_bias) +
+              (fixed ? 0.01 : 0.05) * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+    f.sigma_h_m = fixed ? 0.015 : 0.4;
+    f.sigma_v_m = fixed ? 0.03 : 0.8;
+    f.quality = fixed ? 4 : 5;
+    fixes.push_back(f);
+  }
+  const GlobalGraphResult r = solveGlobalGraph(nodes, fixes, {}, true, graphConfig());
+  std::vector<double> fixed_error;
+  for (const GraphFix& f : fixes) {
+    if (f.quality != 4) continue;
+    fixed_error.push_back(
+        (r.T[f.node].translation() - nodes[f.node].T_w_b.translation()).head<2>().norm());
+  }
+  std::sort(fixed_error.begin(), fixed_error.end());
+  const double median = fixed_error[fixed_error.size() / 2];
+  std::cout << "fixed epochs: horizontal median " << median << " m\n";
+  EXPECT_LT(median, 0.02);
+}
+
 TEST(GlobalGraph, ASegmentWithoutFixesOrLoopsHoldsItsFirstNode) {
   TwoDrives d = makeTwoDrives(makeLoopWorld());
   std::erase_if(d.fixes, [&](const GraphFix& f) { return d.nodes[f.node].segment == 1; });

@@ -59,6 +59,7 @@ mapping::PlaceDatabase makeDatabase() {
   f.p_enu = Eigen::Vector3d(10.2, 0.9, 1.1);
   f.sigma_h_m = 1.5;
   f.sigma_v_m = 3.0;
+  f.quality = 4;
   db.fixes.push_back(f);
   fusion::GraphLoop l;
   l.i = 0;
@@ -104,6 +105,7 @@ TEST(PlaceDatabaseIo, WrittenAndReadBackExactly) {
   EXPECT_EQ(back.fixes[0].node, 1U);
   EXPECT_EQ(back.fixes[0].p_enu, db.fixes[0].p_enu);
   EXPECT_EQ(back.fixes[0].sigma_v_m, 3.0);
+  EXPECT_EQ(back.fixes[0].quality, 4);
   ASSERT_EQ(back.loops.size(), 1U);
   EXPECT_EQ(back.loops[0].j, 2U);
   EXPECT_EQ(back.loops[0].covariance, db.loops[0].covariance);
@@ -146,6 +148,33 @@ TEST(PlaceDatabaseIo, DamageIsRefusedWithItsByteOffset) {
   std::memcpy(skew.data() + 8 + 4 + 4 + 4 + 4 + 4 * 8, &two, 8);
   refused(skew, "a pose whose rotation is not a rotation");
   EXPECT_THROW(readPlaceDatabase(dir.path() / "missing.bin"), InputError);
+  // The fix's quality (version 2) out of NMEA's range; a version not yet written.
+  const std::size_t quality_at = good.size() - (2 * 8 + 48 * 8) - 4;  // before the one loop
+  std::string bad_quality = good;
+  const std::int32_t twelve = 12;
+  std::memcpy(bad_quality.data() + quality_at, &twelve, 4);
+  refused(bad_quality, "a fix quality that is not 0..9");
+  std::string future = good;
+  const std::uint32_t three = 3;
+  std::memcpy(future.data() + 8, &three, 4);
+  refused(future, "a version this gvio does not read");
+}
+
+// Files written before the fix quality (version 1) are still read, their fixes as quality 1.
+TEST(PlaceDatabaseIo, VersionOneIsReadWithSinglePointFixes) {
+  const test::TempDir dir("place_db_v1");
+  const fs::path file = dir.path() / "keyframes.bin";
+  writePlaceDatabase(file, makeDatabase());
+  std::string v1 = bytesOf(file);
+  const std::uint32_t one = 1;
+  std::memcpy(v1.data() + 8, &one, 4);
+  v1.erase(v1.size() - (2 * 8 + 48 * 8) - 4, 4);
+  const mapping::PlaceDatabase back = parsePlaceDatabase(v1, file);
+  ASSERT_EQ(back.fixes.size(), 1U);
+  EXPECT_EQ(back.fixes[0].quality, 1);
+  EXPECT_EQ(back.fixes[0].sigma_v_m, 3.0);
+  ASSERT_EQ(back.loops.size(), 1U);
+  EXPECT_EQ(back.loops[0].covariance, makeDatabase().loops[0].covariance);
 }
 
 }  // namespace
