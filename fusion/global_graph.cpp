@@ -3,11 +3,9 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <map>
 #include <memory>
 
 #include <ceres/loss_function.h>
-#include <ceres/normal_prior.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
@@ -166,7 +164,7 @@ class Graph {
 
   void addFixes(ceres::Problem& problem) {
     const bool with_bias = config_.bias_ratio > 0.0;
-    std::map<int, std::size_t> last_of_quality;  // in the current drive
+    ReceiverBiasChains chains(config_.bias_tau_s);
     for (std::size_t k = 0; k < fixes_.size(); ++k) {
       const GraphFix& f = fixes_[k];
       double* pose = poses_[f.node].data();
@@ -178,25 +176,10 @@ class Graph {
       problem.AddResidualBlock(
           new GnssBiasedPositionFactor(f.q_b, f.p_enu, f.sigma_h_m, f.sigma_v_m), &huber_, pose,
           biases_[k].data());
-      // One bias chain per drive and fix quality (as the smoother: an RTK fixed, a float and a
-      // single-point solution are different error processes); each drive has its own receiver
-      // (or its own day).
-      const std::uint32_t segment = nodes_[f.node].segment;
-      if (k == 0 || segment != nodes_[fixes_[k - 1].node].segment) last_of_quality.clear();
-      const auto last = last_of_quality.find(f.quality);
-      const double sigma_b = config_.bias_ratio * f.sigma_h_m;
-      if (last == last_of_quality.end()) {
-        // The bias's stationary distribution at a chain's first fix: N(0, sigma^2 I).
-        const Eigen::Matrix3d A = Eigen::Matrix3d::Identity() / sigma_b;
-        problem.AddResidualBlock(new ceres::NormalPrior(A, Eigen::Vector3d::Zero()), nullptr,
-                                 biases_[k].data());
-      } else {
-        const std::size_t j = last->second;
-        const double dt = static_cast<double>(f.t_ns - fixes_[j].t_ns) * 1e-9;
-        problem.AddResidualBlock(new GaussMarkovFactor(dt, config_.bias_tau_s, sigma_b), nullptr,
-                                 biases_[j].data(), biases_[k].data());
-      }
-      last_of_quality[f.quality] = k;
+      // One bias chain per drive and fix quality (ReceiverBiasChains): each drive has its own
+      // receiver (or its own day).
+      if (k > 0 && nodes_[f.node].segment != nodes_[fixes_[k - 1].node].segment) chains.restart();
+      chains.add(problem, f.quality, f.t_ns, config_.bias_ratio * f.sigma_h_m, biases_[k].data());
     }
   }
 

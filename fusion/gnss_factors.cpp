@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <ceres/normal_prior.h>
+
 #include "odometry/lie.hpp"
 #include "odometry/pose_manifold.hpp"
 
@@ -121,6 +123,20 @@ bool GaussMarkovFactor::Evaluate(double const* const* parameters, double* residu
     Eigen::Map<Jac3>{jacobians[1]} = inv_sigma_w_ * Eigen::Matrix3d::Identity();
   }
   return true;
+}
+
+void ReceiverBiasChains::add(ceres::Problem& problem, int quality, std::int64_t t_ns,
+                             double sigma_b, double* bias) {
+  const auto last = last_.find(quality);
+  if (last == last_.end()) {
+    const Eigen::Matrix3d A = Eigen::Matrix3d::Identity() / sigma_b;
+    problem.AddResidualBlock(new ceres::NormalPrior(A, Eigen::Vector3d::Zero()), nullptr, bias);
+  } else {
+    const double dt = static_cast<double>(t_ns - last->second.t_ns) * 1e-9;
+    problem.AddResidualBlock(new GaussMarkovFactor(dt, tau_s_, sigma_b), nullptr, last->second.bias,
+                             bias);
+  }
+  last_[quality] = {t_ns, bias};
 }
 
 TiltFactor::TiltFactor(const Eigen::Vector3d& g_b, double sigma_rad)

@@ -2,6 +2,10 @@
 // Factors of the global GNSS fusion graph (fusion/graph_fusion.hpp). Nodes are body poses in ENU on
 // odometry::PoseManifold (tangent (dphi, dp), perturbation (R Exp(dphi), p + R dp)); analytic
 // Jacobians are handed to Ceres as J_tangent * MinusJacobian(x), as the estimator's factors do.
+#include <cstdint>
+#include <map>
+
+#include <ceres/problem.h>
 #include <ceres/sized_cost_function.h>
 
 #include <Eigen/Core>
@@ -72,6 +76,31 @@ class GaussMarkovFactor final : public ceres::SizedCostFunction<3, 3, 3> {
 
  private:
   double phi_, inv_sigma_w_;
+};
+
+// The receiver's correlated error as Gauss-Markov chains of bias states, one chain per fix
+// quality: an RTK fixed, a float and a single-point solution are different error processes (a
+// float epoch's metre comes from its unresolved ambiguities, a fixed epoch's centimetres do not),
+// so a float bias must not be carried into the fixed epochs by a chain whose steps there are
+// centimetres. Each chain starts from the bias's stationary distribution, N(0, sigma^2 I); across
+// a gap in one quality it decorrelates by exp(-dt / tau). Used by the smoother and the global
+// graph, which add their fixes in time order.
+class ReceiverBiasChains {
+ public:
+  explicit ReceiverBiasChains(double tau_s) : tau_s_(tau_s) {}
+  // A new receiver (another drive): every chain starts again.
+  void restart() { last_.clear(); }
+  // The bias state `bias` of a fix of `quality` at t_ns, sigma_b its steady-state sigma: the
+  // stationary prior at its chain's first fix, else the Gauss-Markov step from the chain's last.
+  void add(ceres::Problem& problem, int quality, std::int64_t t_ns, double sigma_b, double* bias);
+
+ private:
+  struct Last {
+    std::int64_t t_ns;
+    double* bias;
+  };
+  double tau_s_;
+  std::map<int, Last> last_;
 };
 
 // The gravity direction in the body as the VIO (with an IMU) observes it, g_b = R_w_b^T e_z: roll

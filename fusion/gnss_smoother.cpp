@@ -9,7 +9,6 @@
 
 #include <ceres/covariance.h>
 #include <ceres/loss_function.h>
-#include <ceres/normal_prior.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
@@ -143,29 +142,11 @@ SmootherSolve solveOnce(const SmootherProblem& in, const std::vector<bool>& use,
                                                     in.noise.positionSigmaM(dist)),
                              nullptr, poses[k - 1], poses[k]);
   }
-  // The receiver's bias: one Gauss-Markov chain per fix quality. An RTK fixed, a float and a
-  // single-point solution are different error processes (a float epoch's metre comes from its
-  // unresolved ambiguities, a fixed epoch's centimetres do not), so a float bias must not be
-  // carried into the fixed epochs by a chain whose steps there are centimetres; across a gap in
-  // one quality the chain decorrelates by exp(-dt / tau). Each chain starts from the bias's
-  // stationary distribution, N(0, sigma^2 I).
-  std::map<int, std::size_t>
-      last_of_quality;  // the fix whose bias the next of its quality continues
+  // The receiver's bias: one Gauss-Markov chain per fix quality (ReceiverBiasChains).
+  ReceiverBiasChains chains(config.bias_tau_s);
   for (std::size_t k = 0; with_bias && k < n; ++k) {
-    const SmootherFix& f = fixes[k];
-    const double sigma_b = config.bias_ratio * f.sigma_h_m * scale[k].x();
-    const auto last = last_of_quality.find(f.quality);
-    if (last == last_of_quality.end()) {
-      const Eigen::Matrix3d A = Eigen::Matrix3d::Identity() / sigma_b;
-      problem.AddResidualBlock(new ceres::NormalPrior(A, Eigen::Vector3d::Zero()), nullptr,
-                               biases[k]);
-    } else {
-      const std::size_t j = last->second;
-      const double dt = static_cast<double>(f.t_ns - fixes[j].t_ns) * 1e-9;
-      problem.AddResidualBlock(new GaussMarkovFactor(dt, config.bias_tau_s, sigma_b), nullptr,
-                               biases[j], biases[k]);
-    }
-    last_of_quality[f.quality] = k;
+    chains.add(problem, fixes[k].quality, fixes[k].t_ns,
+               config.bias_ratio * fixes[k].sigma_h_m * scale[k].x(), biases[k]);
   }
   const ceres::Solver::Options options = batchSolverOptions(config.max_iterations);
   ceres::Solver::Summary summary;
