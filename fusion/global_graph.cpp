@@ -10,6 +10,7 @@
 #include <ceres/solver.h>
 
 #include "fusion/batch_solver.hpp"
+#include "fusion/gnss_covariance.hpp"
 #include "fusion/gnss_factors.hpp"
 #include "odometry/error.hpp"
 #include "odometry/pose_manifold.hpp"
@@ -168,18 +169,18 @@ class Graph {
     for (std::size_t k = 0; k < fixes_.size(); ++k) {
       const GraphFix& f = fixes_[k];
       double* pose = poses_[f.node].data();
+      const Eigen::Matrix3d W = gnssSqrtInformation(f.sigma_h_m, f.sigma_v_m, f.shape_en);
       if (!with_bias) {
-        problem.AddResidualBlock(new GnssPositionFactor(f.q_b, f.p_enu, f.sigma_h_m, f.sigma_v_m),
-                                 &huber_, pose);
+        problem.AddResidualBlock(new GnssPositionFactor(f.q_b, f.p_enu, W), &huber_, pose);
         continue;
       }
-      problem.AddResidualBlock(
-          new GnssBiasedPositionFactor(f.q_b, f.p_enu, f.sigma_h_m, f.sigma_v_m), &huber_, pose,
-          biases_[k].data());
+      problem.AddResidualBlock(new GnssBiasedPositionFactor(f.q_b, f.p_enu, W), &huber_, pose,
+                               biases_[k].data());
       // One bias chain per drive and fix quality (ReceiverBiasChains): each drive has its own
       // receiver (or its own day).
       if (k > 0 && nodes_[f.node].segment != nodes_[fixes_[k - 1].node].segment) chains.restart();
-      chains.add(problem, f.quality, f.t_ns, config_.bias_ratio * f.sigma_h_m, biases_[k].data());
+      chains.add(problem, f.quality, f.t_ns, config_.bias_ratio * f.sigma_h_m, f.shape_en,
+                 biases_[k].data());
     }
   }
 

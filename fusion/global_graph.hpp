@@ -60,6 +60,7 @@ struct GraphFix {
   Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();
   double sigma_h_m = 1.0, sigma_v_m = 1.0;
   int quality = 1;  // NMEA GGA fix quality: each quality has its own receiver-bias chain
+  Eigen::Matrix2d shape_en = Eigen::Matrix2d::Identity();  // the stated ellipse's shape
 };
 
 // A loop closure: the relative pose T_i_j = T_i^-1 T_j of two nodes (i older) and the covariance

@@ -5,6 +5,7 @@
 
 #include <ceres/normal_prior.h>
 
+#include "fusion/gnss_covariance.hpp"
 #include "odometry/lie.hpp"
 #include "odometry/pose_manifold.hpp"
 
@@ -69,18 +70,22 @@ bool RelativePoseFactor::Evaluate(double const* const* parameters, double* resid
 }
 
 GnssPositionFactor::GnssPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix,
+                                       const Eigen::Matrix3d& sqrt_information)
+    : q_b_(q_b), p_fix_(p_enu_fix), sqrt_info_(sqrt_information) {}
+
+GnssPositionFactor::GnssPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix,
                                        double sigma_h_m, double sigma_v_m)
-    : q_b_(q_b), p_fix_(p_enu_fix), inv_sigma_(1.0 / sigma_h_m, 1.0 / sigma_h_m, 1.0 / sigma_v_m) {}
+    : GnssPositionFactor(q_b, p_enu_fix,
+                         gnssSqrtInformation(sigma_h_m, sigma_v_m, Eigen::Matrix2d::Identity())) {}
 
 bool GnssPositionFactor::Evaluate(double const* const* parameters, double* residuals,
                                   double** jacobians) const {
   const Eigen::Matrix3d R = poseQ(parameters[0]).normalized().toRotationMatrix();
-  Eigen::Map<Eigen::Vector3d>{residuals} =
-      inv_sigma_.asDiagonal() * (poseP(parameters[0]) + R * q_b_ - p_fix_);
+  Eigen::Map<Eigen::Vector3d>{residuals} = sqrt_info_ * (poseP(parameters[0]) + R * q_b_ - p_fix_);
   if (jacobians != nullptr && jacobians[0] != nullptr) {
     // d (R Exp(dphi) q) / d dphi = -R hat(q); d (p + R dp) / d dp = R.
     Eigen::Matrix<double, 3, 6> J;
-    J << inv_sigma_.asDiagonal() * (-R * hat(q_b_)), inv_sigma_.asDiagonal() * R;
+    J << sqrt_info_ * (-R * hat(q_b_)), sqrt_info_ * R;
     Eigen::Map<Eigen::Matrix<double, 3, 7, Eigen::RowMajor>>{jacobians[0]} =
         J * poseMinusJacobian(parameters[0]);
   }
@@ -89,52 +94,59 @@ bool GnssPositionFactor::Evaluate(double const* const* parameters, double* resid
 
 GnssBiasedPositionFactor::GnssBiasedPositionFactor(const Eigen::Vector3d& q_b,
                                                    const Eigen::Vector3d& p_enu_fix,
+                                                   const Eigen::Matrix3d& sqrt_information)
+    : position_(q_b, p_enu_fix, sqrt_information), sqrt_info_(sqrt_information) {}
+
+GnssBiasedPositionFactor::GnssBiasedPositionFactor(const Eigen::Vector3d& q_b,
+                                                   const Eigen::Vector3d& p_enu_fix,
                                                    double sigma_h_m, double sigma_v_m)
-    : position_(q_b, p_enu_fix, sigma_h_m, sigma_v_m),
-      inv_sigma_(1.0 / sigma_h_m, 1.0 / sigma_h_m, 1.0 / sigma_v_m) {}
+    : GnssBiasedPositionFactor(
+          q_b, p_enu_fix, gnssSqrtInformation(sigma_h_m, sigma_v_m, Eigen::Matrix2d::Identity())) {}
 
 bool GnssBiasedPositionFactor::Evaluate(double const* const* parameters, double* residuals,
                                         double** jacobians) const {
   double* pose_jacobian[1] = {jacobians != nullptr ? jacobians[0] : nullptr};
   position_.Evaluate(parameters, residuals, jacobians != nullptr ? pose_jacobian : nullptr);
   const Eigen::Map<const Eigen::Vector3d> b(parameters[1]);
-  Eigen::Map<Eigen::Vector3d>{residuals} += inv_sigma_.cwiseProduct(b);
+  Eigen::Map<Eigen::Vector3d>{residuals} += sqrt_info_ * b;
   if (jacobians != nullptr && jacobians[1] != nullptr) {
-    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>{jacobians[1]} =
-        inv_sigma_.asDiagonal();
+    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>{jacobians[1]} = sqrt_info_;
   }
   return true;
 }
 
-GaussMarkovFactor::GaussMarkovFactor(double dt_s, double tau_s, double sigma)
-    : phi_(std::exp(-dt_s / tau_s)),
-      // A floor on the driving noise keeps the factor finite for coincident states (dt = 0).
-      inv_sigma_w_(1.0 / std::max(sigma * std::sqrt(1.0 - phi_ * phi_), 1e-6 * sigma)) {}
+GaussMarkovFactor::GaussMarkovFactor(double dt_s, double tau_s, double sigma,
+                                     const Eigen::Matrix2d& shape_en)
+    : phi_(std::exp(-dt_s / tau_s)) {
+  // A floor on the driving noise keeps the factor finite for coincident states (dt = 0).
+  const double sigma_w = std::max(sigma * std::sqrt(1.0 - phi_ * phi_), 1e-6 * sigma);
+  sqrt_info_w_ = gnssSqrtInformation(sigma_w, sigma_w, shape_en);
+}
 
 bool GaussMarkovFactor::Evaluate(double const* const* parameters, double* residuals,
                                  double** jacobians) const {
   const Eigen::Map<const Eigen::Vector3d> b_i(parameters[0]), b_j(parameters[1]);
-  Eigen::Map<Eigen::Vector3d>{residuals} = inv_sigma_w_ * (b_j - phi_ * b_i);
+  Eigen::Map<Eigen::Vector3d>{residuals} = sqrt_info_w_ * (b_j - phi_ * b_i);
   using Jac3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
   if (jacobians != nullptr && jacobians[0] != nullptr) {
-    Eigen::Map<Jac3>{jacobians[0]} = -inv_sigma_w_ * phi_ * Eigen::Matrix3d::Identity();
+    Eigen::Map<Jac3>{jacobians[0]} = -phi_ * sqrt_info_w_;
   }
   if (jacobians != nullptr && jacobians[1] != nullptr) {
-    Eigen::Map<Jac3>{jacobians[1]} = inv_sigma_w_ * Eigen::Matrix3d::Identity();
+    Eigen::Map<Jac3>{jacobians[1]} = sqrt_info_w_;
   }
   return true;
 }
 
 void ReceiverBiasChains::add(ceres::Problem& problem, int quality, std::int64_t t_ns,
-                             double sigma_b, double* bias) {
+                             double sigma_b, const Eigen::Matrix2d& shape_en, double* bias) {
   const auto last = last_.find(quality);
   if (last == last_.end()) {
-    const Eigen::Matrix3d A = Eigen::Matrix3d::Identity() / sigma_b;
+    const Eigen::Matrix3d A = gnssSqrtInformation(sigma_b, sigma_b, shape_en);
     problem.AddResidualBlock(new ceres::NormalPrior(A, Eigen::Vector3d::Zero()), nullptr, bias);
   } else {
     const double dt = static_cast<double>(t_ns - last->second.t_ns) * 1e-9;
-    problem.AddResidualBlock(new GaussMarkovFactor(dt, tau_s_, sigma_b), nullptr, last->second.bias,
-                             bias);
+    problem.AddResidualBlock(new GaussMarkovFactor(dt, tau_s_, sigma_b, shape_en), nullptr,
+                             last->second.bias, bias);
   }
   last_[quality] = {t_ns, bias};
 }

@@ -38,9 +38,13 @@ class RelativePoseFactor final : public ceres::SizedCostFunction<6, 7, 7> {
 
 // A GNSS fix of the antenna on node i: the antenna sits at q_b in the node's body frame (the lever
 // arm carried by the VIO motion from the node's time to the fix time), so
-//   r = diag(1/sigma_h, 1/sigma_h, 1/sigma_v) (p_i + R_i q_b - p_enu_fix).
+//   r = W (p_i + R_i q_b - p_enu_fix),
+// W the fix's square-root information (gnssSqrtInformation: the stated ellipse; a circle gives
+// W = diag(1/sigma_h, 1/sigma_h, 1/sigma_v)).
 class GnssPositionFactor final : public ceres::SizedCostFunction<3, 7> {
  public:
+  GnssPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix,
+                     const Eigen::Matrix3d& sqrt_information);
   GnssPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix, double sigma_h_m,
                      double sigma_v_m);
   bool Evaluate(double const* const* parameters, double* residuals,
@@ -48,13 +52,15 @@ class GnssPositionFactor final : public ceres::SizedCostFunction<3, 7> {
 
  private:
   Eigen::Vector3d q_b_, p_fix_;
-  Eigen::Vector3d inv_sigma_;
+  Eigen::Matrix3d sqrt_info_;
 };
 
 // A GNSS fix with the receiver's correlated error as a state b (fusion/gnss_smoother.hpp):
-//   r = diag(1/sigma_h, 1/sigma_h, 1/sigma_v) (p_i + R_i q_b + b - p_enu_fix).
+//   r = W (p_i + R_i q_b + b - p_enu_fix).
 class GnssBiasedPositionFactor final : public ceres::SizedCostFunction<3, 7, 3> {
  public:
+  GnssBiasedPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix,
+                           const Eigen::Matrix3d& sqrt_information);
   GnssBiasedPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix,
                            double sigma_h_m, double sigma_v_m);
   bool Evaluate(double const* const* parameters, double* residuals,
@@ -62,20 +68,25 @@ class GnssBiasedPositionFactor final : public ceres::SizedCostFunction<3, 7, 3> 
 
  private:
   GnssPositionFactor position_;
-  Eigen::Vector3d inv_sigma_;
+  Eigen::Matrix3d sqrt_info_;
 };
 
 // First-order Gauss-Markov process between two bias states dt apart (Groves 2013, App. I):
 //   b_j = phi b_i + w, phi = exp(-dt / tau), var(w) = sigma^2 (1 - phi^2);
 //   r = (b_j - phi b_i) / sqrt(var(w)).
+// With a horizontal shape S (GnssFix::shape_en) the driving noise is sigma^2 (1 - phi^2)
+// blockdiag(S, 1): the receiver's slow error follows the satellites' geometry as its white noise
+// does (a pseudorange bias maps into position through the same (H^T H)^-1).
 class GaussMarkovFactor final : public ceres::SizedCostFunction<3, 3, 3> {
  public:
-  GaussMarkovFactor(double dt_s, double tau_s, double sigma);
+  GaussMarkovFactor(double dt_s, double tau_s, double sigma,
+                    const Eigen::Matrix2d& shape_en = Eigen::Matrix2d::Identity());
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
  private:
-  double phi_, inv_sigma_w_;
+  double phi_;
+  Eigen::Matrix3d sqrt_info_w_;
 };
 
 // The receiver's correlated error as Gauss-Markov chains of bias states, one chain per fix
@@ -90,9 +101,11 @@ class ReceiverBiasChains {
   explicit ReceiverBiasChains(double tau_s) : tau_s_(tau_s) {}
   // A new receiver (another drive): every chain starts again.
   void restart() { last_.clear(); }
-  // The bias state `bias` of a fix of `quality` at t_ns, sigma_b its steady-state sigma: the
-  // stationary prior at its chain's first fix, else the Gauss-Markov step from the chain's last.
-  void add(ceres::Problem& problem, int quality, std::int64_t t_ns, double sigma_b, double* bias);
+  // The bias state `bias` of a fix of `quality` at t_ns, sigma_b its steady-state sigma and
+  // shape_en its horizontal shape (the fix's ellipse): the stationary prior at its chain's first
+  // fix, else the Gauss-Markov step from the chain's last.
+  void add(ceres::Problem& problem, int quality, std::int64_t t_ns, double sigma_b,
+           const Eigen::Matrix2d& shape_en, double* bias);
 
  private:
   struct Last {

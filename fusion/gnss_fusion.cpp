@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "fusion/gnss_covariance.hpp"
 #include "fusion/gnss_factors.hpp"
 #include "fusion/gnss_fusion_impl.hpp"
 #include "odometry/error.hpp"
@@ -21,6 +22,11 @@ constexpr double kNoVelocityVariance = 1e8;
 // Consecutive fixes further apart than this say little about the receiver's white noise (the VIO
 // drifts, the receiver's slow error decorrelates).
 constexpr double kMaxNoiseDifferencingS = 2.0;
+
+// The fix's whitening, its stated ellipse kept.
+Eigen::Matrix3d sqrtInformation(const GnssFix& fix) {
+  return gnssSqrtInformation(fix.sigma_h_m, fix.sigma_v_m, fix.shape_en);
+}
 
 }  // namespace
 
@@ -111,7 +117,8 @@ void GnssFusion::Impl::noteAccepted(std::int64_t t_ns) {
 
 void GnssFusion::Impl::noteOutcome(const Pair& pair, bool used) {
   stats.fixes.push_back({pair.t_ns, pair.p_enu, used ? FixStatus::kUsed : FixStatus::kRejected,
-                         pair.fix.sigma_h_m, pair.fix.sigma_v_m, pair.fix.quality});
+                         pair.fix.sigma_h_m, pair.fix.sigma_v_m, pair.fix.quality,
+                         pair.fix.shape_en});
   if (used) {
     noteAccepted(pair.t_ns);
   } else {
@@ -124,8 +131,8 @@ bool GnssFusion::Impl::fuseGraph(const Pair& pair) {
   if (graph.empty()) {
     GraphNode& n = graph.addNode(pair.t_ns, *T_enu_w * pair.T_w_b, pair.T_w_b, nullptr);
     addNodePriors(n, true);
-    graph.addGnssFactor(n, std::make_shared<GnssPositionFactor>(
-                               lever, pair.p_enu, pair.fix.sigma_h_m, pair.fix.sigma_v_m));
+    graph.addGnssFactor(
+        n, std::make_shared<GnssPositionFactor>(lever, pair.p_enu, sqrtInformation(pair.fix)));
     graph.solve();
     noteGraphNode(pair);
     return true;
@@ -141,10 +148,10 @@ bool GnssFusion::Impl::fuseGraph(const Pair& pair) {
   const double sigma_motion = noise.positionSigmaM(dist);
   const double var_pred = sigma_motion * sigma_motion + config.gate_floor_m * config.gate_floor_m;
   const Eigen::Vector3d innovation = pair.p_enu - T_pred * lever;
-  const double var_h = 2.0 * pair.fix.sigma_h_m * pair.fix.sigma_h_m + var_pred;
-  const Eigen::Vector3d variance(var_h, var_h,
-                                 2.0 * pair.fix.sigma_v_m * pair.fix.sigma_v_m + var_pred);
-  const double chi2 = innovation.cwiseAbs2().cwiseQuotient(variance).sum();
+  const Eigen::Matrix3d covariance =
+      2.0 * gnssCovariance(pair.fix.sigma_h_m, pair.fix.sigma_v_m, pair.fix.shape_en) +
+      var_pred * Eigen::Matrix3d::Identity();
+  const double chi2 = innovation.dot(covariance.ldlt().solve(innovation));
   if (chi2 > config.gate_chi2 && consecutive_rejections < config.max_consecutive_rejections) {
     return false;
   }
@@ -152,8 +159,8 @@ bool GnssFusion::Impl::fuseGraph(const Pair& pair) {
                                                        noise.positionSigmaM(dist));
   GraphNode& n = graph.addNode(pair.t_ns, T_pred, pair.T_w_b, relative);
   addNodePriors(n, false);
-  graph.addGnssFactor(n, std::make_shared<GnssPositionFactor>(lever, pair.p_enu, pair.fix.sigma_h_m,
-                                                              pair.fix.sigma_v_m));
+  graph.addGnssFactor(
+      n, std::make_shared<GnssPositionFactor>(lever, pair.p_enu, sqrtInformation(pair.fix)));
   graph.solve();
   noteGraphNode(pair);
   return true;
@@ -188,7 +195,8 @@ void GnssFusion::Impl::addNodePriors(GraphNode& node, bool first) {
 
 void GnssFusion::Impl::noteGraphNode(const Pair& pair) {
   graph_fixes.push_back({pair.t_ns, pair.T_w_b, graph.newest().T_enu_b(), pair.p_enu,
-                         pair.fix.sigma_h_m, pair.fix.sigma_v_m, pair.fix.quality});
+                         pair.fix.sigma_h_m, pair.fix.sigma_v_m, pair.fix.quality,
+                         pair.fix.shape_en});
 }
 
 void GnssFusion::Impl::smooth() {
@@ -214,9 +222,8 @@ bool GnssFusion::Impl::fuseKf(const Pair& pair) {
   // The stated sigmas, scaled by what the earlier fixes of this quality showed.
   const Eigen::Vector2d scale =
       config.kf.learn_noise ? kf_noise.scale(pair.fix.quality) : Eigen::Vector2d::Ones();
-  const auto variances = [&](const GnssFix& fix) -> Eigen::Vector3d {
-    const double h = fix.sigma_h_m * scale.x(), v = fix.sigma_v_m * scale.y();
-    return {h * h, h * h, v * v};
+  const auto covariance = [&](const GnssFix& fix) -> Eigen::Matrix3d {
+    return gnssCovariance(fix.sigma_h_m * scale.x(), fix.sigma_v_m * scale.y(), fix.shape_en);
   };
   const auto stated = [](const GnssFix& fix) -> Eigen::Vector3d {
     return {fix.sigma_h_m * fix.sigma_h_m, fix.sigma_h_m * fix.sigma_h_m,
@@ -224,11 +231,11 @@ bool GnssFusion::Impl::fuseKf(const Pair& pair) {
   };
   KfBaseline::Vector6d z;
   KfBaseline::Matrix6d R = KfBaseline::Matrix6d::Zero();
-  const Eigen::Vector3d var_p = variances(pair.fix);
+  const Eigen::Matrix3d cov_p = covariance(pair.fix);
   double dt_prev = 0.0;
   GnssFix prev_fix;
   z.head<3>() = pair.p_enu - p_vio;
-  R.diagonal().head<3>() = var_p;
+  R.topLeftCorner<3, 3>() = cov_p;
   // No Doppler in the input: GNSS velocity by finite differences of consecutive fixes, against the
   // VIO's over the same interval (the reference method's fallback).
   z.tail<3>().setZero();
@@ -238,7 +245,7 @@ bool GnssFusion::Impl::fuseKf(const Pair& pair) {
     if (dt > 0.0) {
       const Eigen::Vector3d p_vio_prev = *T_enu_w * (previous_fix->T_w_b * lever);
       z.tail<3>() = (pair.p_enu - previous_fix->p_enu) / dt - (p_vio - p_vio_prev) / dt;
-      R.diagonal().tail<3>() = (var_p + variances(previous_fix->fix)) / (dt * dt);
+      R.bottomRightCorner<3, 3>() = (cov_p + covariance(previous_fix->fix)) / (dt * dt);
       dt_prev = dt;
       prev_fix = previous_fix->fix;
     }
@@ -270,7 +277,8 @@ void GnssFusion::Impl::processFix(const GnssFix& fix) {
   if (!T_w_b) {
     ++stats.fixes_unmatched;
     stats.fixes.push_back({fix.t_ns, enu.toEnu({fix.lat_deg, fix.lon_deg, fix.h_ellipsoid_m}),
-                           FixStatus::kUnmatched, fix.sigma_h_m, fix.sigma_v_m, fix.quality});
+                           FixStatus::kUnmatched, fix.sigma_h_m, fix.sigma_v_m, fix.quality,
+                           fix.shape_en});
     return;
   }
   Pair pair{fix.t_ns, *T_w_b, enu.toEnu({fix.lat_deg, fix.lon_deg, fix.h_ellipsoid_m}), fix};
@@ -321,8 +329,8 @@ void GnssFusion::finish() {
     s.pending.pop_front();
   }
   for (const Impl::Pair& p : s.alignment_pairs) {
-    s.stats.fixes.push_back(
-        {p.t_ns, p.p_enu, FixStatus::kUnaligned, p.fix.sigma_h_m, p.fix.sigma_v_m, p.fix.quality});
+    s.stats.fixes.push_back({p.t_ns, p.p_enu, FixStatus::kUnaligned, p.fix.sigma_h_m,
+                             p.fix.sigma_v_m, p.fix.quality, p.fix.shape_en});
   }
   s.alignment_pairs.clear();
   if (s.config.mode == FusionMode::kKf && s.config.kf.learn_noise) {

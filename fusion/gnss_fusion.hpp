@@ -87,6 +87,7 @@ struct FixOutcome {
   FixStatus status = FixStatus::kUsed;
   double sigma_h_m = 0.0, sigma_v_m = 0.0;  // as the fix reports them
   int quality = 1;                          // NMEA GGA fix quality (RTK fixed 4, float 5, ...)
+  Eigen::Matrix2d shape_en = Eigen::Matrix2d::Identity();  // its ellipse (GnssFix::shape_en)
 };
 
 struct FusionStats {

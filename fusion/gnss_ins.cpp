@@ -8,6 +8,7 @@
 #include <numbers>
 #include <string>
 
+#include "fusion/gnss_covariance.hpp"
 #include "fusion/ins_heading_bank.hpp"
 #include "odometry/error.hpp"
 #include "odometry/lie.hpp"
@@ -220,9 +221,7 @@ bool GnssIns::update(const InsMeasurement<Rows>& m, const Eigen::Matrix<double, 
 void GnssIns::updatePosition(const GnssFix& fix, const Eigen::Vector3d& p_ant) {
   const InsMeasurement<3> m =
       antennaPosition(x_, last_imu_->gyr_b_radps, config_.lever_arm_b, stampMinusFilter(fix.t_ns));
-  const Eigen::Vector3d var(fix.sigma_h_m * fix.sigma_h_m, fix.sigma_h_m * fix.sigma_h_m,
-                            fix.sigma_v_m * fix.sigma_v_m);
-  const Eigen::Matrix3d R = var.asDiagonal();
+  const Eigen::Matrix3d R = gnssCovariance(fix.sigma_h_m, fix.sigma_v_m, fix.shape_en);
   const bool force = consecutive_rejections_ >= config_.max_consecutive_rejections;
   if (force) {
     // Re-convergence after a run of rejections: widen the position uncertainty to the innovation

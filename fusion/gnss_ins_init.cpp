@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "fusion/gnss_covariance.hpp"
 #include "fusion/gnss_ins.hpp"
 #include "fusion/ins_heading_bank.hpp"
 
@@ -142,8 +143,7 @@ void GnssIns::startBank() {
 InsMatrix GnssIns::initialCovariance(const GnssFix& fix, const Eigen::Matrix3d& R,
                                      double heading_sigma_rad) const {
   InsMatrix P = InsMatrix::Zero();
-  P.block<3, 3>(kInsP, kInsP).diagonal() << fix.sigma_h_m * fix.sigma_h_m,
-      fix.sigma_h_m * fix.sigma_h_m, fix.sigma_v_m * fix.sigma_v_m;
+  P.block<3, 3>(kInsP, kInsP) = gnssCovariance(fix.sigma_h_m, fix.sigma_v_m, fix.shape_en);
   P.block<3, 3>(kInsV, kInsV).diagonal().setConstant(std::pow(config_.init_velocity_sigma_mps, 2));
   // Tilt and heading sigmas are about ENU axes; the error angle is in the body (local) frame.
   const double tilt = config_.init_tilt_sigma_deg * kDegToRad;

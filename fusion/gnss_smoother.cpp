@@ -13,6 +13,7 @@
 #include <ceres/solver.h>
 
 #include "fusion/batch_solver.hpp"
+#include "fusion/gnss_covariance.hpp"
 #include "fusion/gnss_factors.hpp"
 #include "odometry/error.hpp"
 #include "odometry/pose_manifold.hpp"
@@ -123,10 +124,11 @@ SmootherSolve solveOnce(const SmootherProblem& in, const std::vector<bool>& use,
       const Eigen::Vector3d g_b = f.T_w_b.rotation().transpose() * Eigen::Vector3d::UnitZ();
       problem.AddResidualBlock(new TiltFactor(g_b, in.tilt_sigma_rad), nullptr, poses[k]);
     }
+    const Eigen::Matrix3d W = gnssSqrtInformation(sigma_h, sigma_v, f.shape_en);
     if (with_bias) {
-      fix_factors[k] = new GnssBiasedPositionFactor(lever_arm_b, f.p_enu, sigma_h, sigma_v);
+      fix_factors[k] = new GnssBiasedPositionFactor(lever_arm_b, f.p_enu, W);
     } else {
-      fix_factors[k] = new GnssPositionFactor(lever_arm_b, f.p_enu, sigma_h, sigma_v);
+      fix_factors[k] = new GnssPositionFactor(lever_arm_b, f.p_enu, W);
     }
     if (use[k]) {
       std::vector<double*> blocks = {poses[k]};
@@ -146,7 +148,7 @@ SmootherSolve solveOnce(const SmootherProblem& in, const std::vector<bool>& use,
   ReceiverBiasChains chains(config.bias_tau_s);
   for (std::size_t k = 0; with_bias && k < n; ++k) {
     chains.add(problem, fixes[k].quality, fixes[k].t_ns,
-               config.bias_ratio * fixes[k].sigma_h_m * scale[k].x(), biases[k]);
+               config.bias_ratio * fixes[k].sigma_h_m * scale[k].x(), fixes[k].shape_en, biases[k]);
   }
   const ceres::Solver::Options options = batchSolverOptions(config.max_iterations);
   ceres::Solver::Summary summary;

@@ -56,6 +56,7 @@ struct SmootherFix {
   Eigen::Vector3d p_enu = Eigen::Vector3d::Zero();            // antenna position of the fix
   double sigma_h_m = 1.0, sigma_v_m = 1.0;
   int quality = 1;  // NMEA GGA fix quality: the noise is learned per quality
+  Eigen::Matrix2d shape_en = Eigen::Matrix2d::Identity();  // the stated ellipse's shape
 };
 
 // The VIO relative-motion noise between nodes: sigma = fraction * distance + floor (rotation:

@@ -27,11 +27,14 @@ struct GnssFix {
   double lat_deg = 0.0;
   double lon_deg = 0.0;
   double h_ellipsoid_m = 0.0;
-  double sigma_h_m = 0.0;  // 1-sigma horizontal (per axis)
+  double sigma_h_m = 0.0;  // 1-sigma horizontal (per axis: sqrt of half the covariance's trace)
   double sigma_v_m = 0.0;  // 1-sigma vertical
-  int quality = 1;         // NMEA GGA fix quality (1 SPP, 2 DGPS, 4 RTK fixed, 5 RTK float)
-  double hdop = 0.0;       // 0 when the source does not report it
-  int num_sats = 0;        // 0 when the source does not report it
+  // The shape of the stated horizontal error ellipse (east, north): cov_en = sigma_h_m^2 shape_en,
+  // trace 2 (fusion/gnss_covariance.hpp); the identity where the source states no correlation.
+  Eigen::Matrix2d shape_en = Eigen::Matrix2d::Identity();
+  int quality = 1;    // NMEA GGA fix quality (1 SPP, 2 DGPS, 4 RTK fixed, 5 RTK float)
+  double hdop = 0.0;  // 0 when the source does not report it
+  int num_sats = 0;   // 0 when the source does not report it
   // Velocity over ground as the receiver reports it (speed and course, the course clockwise from
   // true north); NaN when the source does not report it.
   double speed_mps = std::numeric_limits<double>::quiet_NaN();

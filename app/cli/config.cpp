@@ -276,6 +276,7 @@ std::vector<ConfigKey> configKeys(AppConfig& c) {
       number("dataset.nmea_uere_rtk_fixed_m", c.dataset.nmea_uere_rtk_fixed_m),
       number("dataset.nmea_vertical_factor", c.dataset.nmea_vertical_factor),
       text("dataset.nmea_checksum", c.dataset.nmea_checksum),
+      text("dataset.gnss_ellipse", c.dataset.gnss_ellipse),
       number("dataset.comma2k19_sigma_h_m", c.dataset.comma2k19_sigma_h_m),
       number("dataset.comma2k19_sigma_v_m", c.dataset.comma2k19_sigma_v_m),
       text("dataset.topics.cam0", c.dataset.topic_cam0),

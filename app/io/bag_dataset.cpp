@@ -9,6 +9,7 @@
 #include <limits>
 #include <optional>
 
+#include "fusion/gnss_covariance.hpp"
 #include "fusion/gnss_screening.hpp"
 #include "io/input_error.hpp"
 #include "io/ros_image.hpp"
@@ -204,6 +205,12 @@ void readGnss(const BagSource& reader, const std::string& topic, const ReaderCon
     fix.sigma_h_m = std::max(stated_h, floor_h);
     fix.sigma_v_m =
         std::max(stated ? std::sqrt(cov[8]) : 0.0, floor_h * config.nmea_vertical_factor);
+    if (stated) {  // east-north correlation only where the whole covariance is known
+      const double en = m.covariance_type == 3 && std::isfinite(cov[1]) ? cov[1] : 0.0;
+      fix.shape_en = fusion::flooredHorizontal(
+                         (Eigen::Matrix2d() << cov[0], en, en, cov[4]).finished(), floor_h)
+                         .shape_en;
+    }
     ds.gnss.push_back(fix);
   }
   use.used = ds.gnss.size();

@@ -56,6 +56,9 @@ Dataset openDataset(const DatasetSources& sources, ReaderConfig config) {
     ds.warnings.emplace_back(missing.what());
   }
   if (sources.gnss_file) useGnssFile(ds, *sources.gnss_file, config);
+  if (config.gnss_ellipse == "circle") {
+    for (GnssFix& fix : ds.gnss) fix.shape_en.setIdentity();
+  }
   return ds;
 }
 

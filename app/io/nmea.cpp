@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 
+#include "fusion/gnss_covariance.hpp"
 #include "io/input_error.hpp"
 #include "io/text.hpp"
 
@@ -31,6 +32,7 @@ struct GstSigma {
   std::size_t line = 0;
   double sigma_h_m = 0.0;
   double sigma_v_m = 0.0;
+  Eigen::Matrix2d shape_en = Eigen::Matrix2d::Identity();  // from the error ellipse, when stated
 };
 struct Skipped {
   std::size_t count = 0;
@@ -170,6 +172,23 @@ void parseRmc(const std::vector<std::string_view>& f, const LineReader& at, Coll
   out.rmc.push_back({at.lineNumber(), *tod, *day});
 }
 
+// The shape of GST's error ellipse (fields 3-5: 1-sigma semi-major and semi-minor axes, the
+// major axis's orientation clockwise from true north); a circle where the receiver leaves them
+// empty or zero (many do, stating only the latitude and longitude sigmas).
+Eigen::Matrix2d gstEllipseShape(const std::vector<std::string_view>& f, const LineReader& at) {
+  if (f[3].empty() || f[4].empty() || f[5].empty()) return Eigen::Matrix2d::Identity();
+  const auto major = toDouble(f[3]);
+  const auto minor = toDouble(f[4]);
+  const auto orientation = toDouble(f[5]);
+  if (!major || *major < 0.0) malformed(at, "GST", "semi-major axis sigma", f[3]);
+  if (!minor || *minor < 0.0) malformed(at, "GST", "semi-minor axis sigma", f[4]);
+  if (!orientation || std::abs(*orientation) > 360.0) {
+    malformed(at, "GST", "ellipse orientation", f[5]);
+  }
+  if (*major <= 0.0 || *minor <= 0.0) return Eigen::Matrix2d::Identity();
+  return fusion::horizontalShape(fusion::ellipseCovariance(*major, *minor, *orientation));
+}
+
 void parseGst(const std::vector<std::string_view>& f, const LineReader& at, Collected& out) {
   if (f.size() < 9) at.fail("malformed GST: " + std::to_string(f.size()) + " fields, need 9+");
   if (f[1].empty() || f[6].empty() || f[7].empty() || f[8].empty()) return;
@@ -185,7 +204,7 @@ void parseGst(const std::vector<std::string_view>& f, const LineReader& at, Coll
   // Some receivers fill GST with zeros when they have no estimate; a zero sigma would claim a
   // perfect fix, so such a GST is ignored and the HDOP model applies.
   if (sigma_h <= 0.0 || *alt <= 0.0) return;
-  out.gst.emplace(*tod, GstSigma{at.lineNumber(), sigma_h, *alt});
+  out.gst.emplace(*tod, GstSigma{at.lineNumber(), sigma_h, *alt, gstEllipseShape(f, at)});
 }
 
 // Body of a sentence whose "*HH" checksum is present and right; nullopt otherwise.
@@ -291,6 +310,7 @@ void setSigmas(GnssFix& fix, std::size_t line, std::int64_t tod_ns, const Collec
         nearestByLine(lo, hi, line, [](const auto& entry) { return entry.second.line; });
     fix.sigma_h_m = it->second.sigma_h_m;
     fix.sigma_v_m = it->second.sigma_v_m;
+    fix.shape_en = it->second.shape_en;
     return;
   }
   const double hdop = fix.hdop > 0.0 ? fix.hdop : 1.0;

@@ -19,7 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr std::string_view kMagic = "GVIOKFDB";
-constexpr std::uint32_t kVersion = 2;  // 2: a fix quality per fix
+constexpr std::uint32_t kVersion = 3;  // 2: a fix quality per fix; 3: its ellipse's shape
 constexpr std::size_t kDescriptorBytes = 32;
 constexpr std::size_t kThumbnail =
     static_cast<std::size_t>(mapping::kThumbnailWidth) * mapping::kThumbnailHeight;
@@ -185,6 +185,14 @@ void readFix(Reader& r, mapping::PlaceDatabase& db, std::uint32_t version) {
     f.quality = r.get<std::int32_t>();
     if (f.quality < 0 || f.quality > 9) r.fail("a fix quality that is not 0..9");
   }
+  if (version >= 3) {
+    const double ee = r.finite(), nn = r.finite(), en = r.finite();
+    f.shape_en << ee, en, en, nn;
+    // What horizontalShape writes: positive definite, trace 2 (a file's rounding allowed).
+    if (!(ee > 0.0 && nn > 0.0 && ee * nn - en * en > 0.0 && std::abs(ee + nn - 2.0) < 1e-9)) {
+      r.fail("a fix ellipse shape that is not positive definite with trace 2");
+    }
+  }
   db.fixes.push_back(f);
 }
 
@@ -233,6 +241,7 @@ void writePlaceDatabase(const fs::path& file, const mapping::PlaceDatabase& db) 
     w.put<double>(f.sigma_h_m);
     w.put<double>(f.sigma_v_m);
     w.put<std::int32_t>(f.quality);
+    for (const double v : {f.shape_en(0, 0), f.shape_en(1, 1), f.shape_en(0, 1)}) w.put<double>(v);
   }
   for (const fusion::GraphLoop& l : db.loops) {
     w.put<std::uint64_t>(l.i);
@@ -274,7 +283,8 @@ mapping::PlaceDatabase parsePlaceDatabase(const std::string& bytes, const fs::pa
   // The smallest record of each kind bounds the counts before anything is allocated.
   const std::size_t n_kf = r.count(keyframes, 8 + 24 * 8 + 3 * 8 + 3 * 4);
   for (std::size_t k = 0; k < n_kf; ++k) readKeyframe(r, db);
-  const std::size_t n_fix = r.count(fixes, 2 * 8 + 8 * 8 + (version >= 2 ? 4 : 0));
+  const std::size_t n_fix =
+      r.count(fixes, 2 * 8 + 8 * 8 + (version >= 2 ? 4 : 0) + (version >= 3 ? 3 * 8 : 0));
   for (std::size_t k = 0; k < n_fix; ++k) readFix(r, db, version);
   const std::size_t n_loop = r.count(loops, 2 * 8 + 48 * 8);
   for (std::size_t k = 0; k < n_loop; ++k) readLoop(r, db);

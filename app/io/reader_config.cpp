@@ -34,6 +34,10 @@ void ReaderConfig::validate() const {
     throw InvalidInput("config: dataset.nmea_checksum must be refuse, warn or skip (got '" +
                        nmea_checksum + "')");
   }
+  if (gnss_ellipse != "stated" && gnss_ellipse != "circle") {
+    throw InvalidInput("config: dataset.gnss_ellipse must be stated or circle (got '" +
+                       gnss_ellipse + "')");
+  }
   requirePositive(comma2k19_sigma_h_m, "dataset.comma2k19_sigma_h_m");
   requirePositive(comma2k19_sigma_v_m, "dataset.comma2k19_sigma_v_m");
   if (!std::isfinite(stereo_sync_tolerance_s) || stereo_sync_tolerance_s < 0.0) {

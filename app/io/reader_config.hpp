@@ -22,6 +22,10 @@ struct ReaderConfig {
   // with the counts per type (a logger that writes every RMC with a wrong checksum); warn: read
   // as they are, with a warning and the counts; skip: always left out, with a warning.
   std::string nmea_checksum = "refuse";  // refuse | warn | skip
+  // The horizontal error ellipse a GNSS source states (RTKLIB sdn/sde/sdne, NMEA GST's ellipse, a
+  // NavSatFix's full covariance): stated = fused as the receiver states it; circle = each fix a
+  // circle of its horizontal sigma (sqrt of half the stated covariance's trace).
+  std::string gnss_ellipse = "stated";  // stated | circle
   // comma2k19's u-blox CSV has no accuracy columns: 1-sigma horizontal (per axis) and vertical.
   double comma2k19_sigma_h_m = 1.0;
   double comma2k19_sigma_v_m = 2.0;

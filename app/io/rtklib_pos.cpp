@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "fusion/geodesy.hpp"
+#include "fusion/gnss_covariance.hpp"
 #include "io/gps_time.hpp"
 #include "io/input_error.hpp"
 #include "io/text.hpp"
@@ -196,10 +197,11 @@ PosFile readRtklibPos(const std::filesystem::path& file, const ReaderConfig& con
       fix.lat_deg = p.x();
       fix.lon_deg = p.y();
       fix.h_ellipsoid_m = p.z();
-      cov_enu.setZero();
-      cov_enu(0, 0) = s[1] * s[1];  // sde
-      cov_enu(1, 1) = s[0] * s[0];  // sdn
-      cov_enu(2, 2) = s[2] * s[2];  // sdu
+      cov_enu.setZero();  // sdn sde sdu sdne sdeu sdun
+      cov_enu(0, 0) = s[1] * s[1];
+      cov_enu(1, 1) = s[0] * s[0];
+      cov_enu(2, 2) = s[2] * s[2];
+      cov_enu(0, 1) = cov_enu(1, 0) = signedSquare(s[3]);
     }
     if (!fusion::isValidLla({fix.lat_deg, fix.lon_deg, fix.h_ellipsoid_m})) {
       in.fail("position out of range");
@@ -221,7 +223,10 @@ PosFile readRtklibPos(const std::filesystem::path& file, const ReaderConfig& con
                            : fix.quality == 5 ? config.nmea_uere_rtk_float_m
                            : fix.quality == 2 ? config.nmea_uere_dgps_m
                                               : config.nmea_uere_spp_m;
-    fix.sigma_h_m = std::max(std::sqrt(0.5 * (cov_enu(0, 0) + cov_enu(1, 1))), floor_h);
+    const fusion::HorizontalError h =
+        fusion::flooredHorizontal(cov_enu.topLeftCorner<2, 2>(), floor_h);
+    fix.sigma_h_m = h.sigma_m;
+    fix.shape_en = h.shape_en;
     fix.sigma_v_m =
         std::max(std::sqrt(std::max(cov_enu(2, 2), 0.0)), floor_h * config.nmea_vertical_factor);
     out.fixes.push_back(fix);

@@ -103,6 +103,7 @@ std::vector<fusion::GraphFix> graphFixes(const std::vector<fusion::GraphNode>& n
     g.sigma_h_m = f.sigma_h_m;
     g.sigma_v_m = f.sigma_v_m;
     g.quality = f.quality;
+    g.shape_en = f.shape_en;
     fixes.push_back(g);
   }
   return fixes;

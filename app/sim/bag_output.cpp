@@ -61,8 +61,15 @@ io::bag::NavSatFixMessage bagFixMessage(const GnssFix& f) {
   m.lon_deg = rounded(f.lon_deg, 10);
   m.alt_m = rounded(f.h_ellipsoid_m, 4);
   const double sigma_h = rounded(f.sigma_h_m, 4), sigma_v = rounded(f.sigma_v_m, 4);
-  m.covariance_enu_m2 = {sigma_h * sigma_h, 0, 0, 0, sigma_h * sigma_h, 0, 0, 0, sigma_v * sigma_v};
-  m.covariance_type = 2;  // COVARIANCE_TYPE_DIAGONAL_KNOWN
+  if (f.shape_en == Eigen::Matrix2d::Identity()) {
+    m.covariance_enu_m2 = {sigma_h * sigma_h, 0, 0, 0, sigma_h * sigma_h, 0, 0, 0,
+                           sigma_v * sigma_v};
+    m.covariance_type = 2;  // COVARIANCE_TYPE_DIAGONAL_KNOWN
+    return m;
+  }
+  const Eigen::Matrix2d cov = sigma_h * sigma_h * f.shape_en;  // a replayed receiver's ellipse
+  m.covariance_enu_m2 = {cov(0, 0), cov(0, 1), 0, cov(1, 0), cov(1, 1), 0, 0, 0, sigma_v * sigma_v};
+  m.covariance_type = 3;  // COVARIANCE_TYPE_KNOWN
   return m;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "fusion/gnss_covariance.hpp"
 #include "io/gps_time.hpp"
 #include "io/nmea.hpp"
 #include "odometry/error.hpp"
@@ -143,11 +144,20 @@ std::string exactDecimal(double value) {
 }
 
 // GST carries the sigmas GGA lacks (rms, error ellipse, lat/lon/alt sigma), written exactly so a
-// reader recovers the reported sigmas; the ellipse is a circle of the horizontal sigma.
+// reader recovers the reported sigmas: a circle of the horizontal sigma, or the fix's ellipse
+// (a replayed receiver's) with its semi-axes, orientation and the latitude and longitude sigmas.
 std::string gstBody(const GnssFix& fix, const std::string& time) {
   const std::string h = exactDecimal(fix.sigma_h_m);
-  return fmt::format("GPGST,{},{},{},{},0.0,{},{},{}", time, h, h, h, h, h,
-                     exactDecimal(fix.sigma_v_m));
+  const std::string v = exactDecimal(fix.sigma_v_m);
+  if (fix.shape_en == Eigen::Matrix2d::Identity()) {
+    return fmt::format("GPGST,{},{},{},{},0.0,{},{},{}", time, h, h, h, h, h, v);
+  }
+  const Eigen::Matrix2d cov_en = fix.sigma_h_m * fix.sigma_h_m * fix.shape_en;
+  const fusion::Ellipse e = fusion::ellipseOf(cov_en);
+  return fmt::format("GPGST,{},{},{},{},{},{},{},{}", time, h, exactDecimal(e.major_m),
+                     exactDecimal(e.minor_m), exactDecimal(e.orientation_deg),
+                     exactDecimal(std::sqrt(cov_en(1, 1))), exactDecimal(std::sqrt(cov_en(0, 0))),
+                     v);
 }
 
 }  // namespace
@@ -203,6 +213,9 @@ std::string toRtklibPos(const std::vector<GnssFix>& fixes) {
       "%  GPST                  latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   "
       "sde(m)   sdu(m)  sdne(m)  sdeu(m)  sdun(m) age(s)  ratio\n";
   for (const GnssFix& f : fixes) {
+    // sdn, sde and sdne (RTKLIB writes a covariance as sign(c) sqrt(|c|)) of the fix's ellipse.
+    const Eigen::Matrix2d cov_en = f.sigma_h_m * f.sigma_h_m * f.shape_en;
+    const double sdne = std::copysign(std::sqrt(std::abs(cov_en(0, 1))), cov_en(0, 1));
     // GPST runs ahead of UTC by the leap seconds of that instant; io/gps_time.hpp's table is
     // indexed by GPST, so the offset read at UTC is read again at the GPST it gives.
     const std::int64_t utc_ahead_s = io::gpsMinusUtcSeconds(f.t_ns);
@@ -212,7 +225,7 @@ std::string toRtklibPos(const std::vector<GnssFix>& fixes) {
         "{} {:14.9f} {:14.9f} {:10.4f} {:3} {:3} {:8.4f} {:8.4f} {:8.4f} {:8.4f} {:8.4f} {:8.4f} "
         "{:6.2f} {:6.1f}\n",
         calendarTime(t_gpst), f.lat_deg, f.lon_deg, f.h_ellipsoid_m, q_of(f.quality), f.num_sats,
-        f.sigma_h_m, f.sigma_h_m, f.sigma_v_m, 0.0, 0.0, 0.0, 0.0, 0.0);
+        std::sqrt(cov_en(1, 1)), std::sqrt(cov_en(0, 0)), f.sigma_v_m, sdne, 0.0, 0.0, 0.0, 0.0);
   }
   return pos;
 }

@@ -38,9 +38,10 @@ std::vector<GnssSimFix> synthesizeGnss(
 // NMEA 0183 log: one GGA and one RMC per fix (valid checksums, HDOP and satellites from the fix).
 std::string toNmeaLog(const std::vector<GnssFix>& fixes);
 // RTKLIB solution (.pos) as RTKPOST writes it: GPST calendar times, latitude/longitude/ellipsoidal
-// height, Q (from the fix's NMEA quality), satellites, sdn = sde = the horizontal sigma, sdu.
+// height, Q (from the fix's NMEA quality), satellites, sdn, sde and sdne of the fix's ellipse, sdu.
 std::string toRtklibPos(const std::vector<GnssFix>& fixes);
-// EuRoC-style gnss0/data.csv: "#timestamp [ns],lat_deg,lon_deg,height_m,sigma_h_m,sigma_v_m".
+// EuRoC-style gnss0/data.csv: "#timestamp [ns],lat_deg,lon_deg,height_m,sigma_h_m,sigma_v_m" (no
+// ellipse: its fixes are circles).
 std::string toGnssCsv(const std::vector<GnssFix>& fixes);
 
 }  // namespace gvio::sim

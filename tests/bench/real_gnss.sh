@@ -4,9 +4,11 @@
 # continuous motion (tests/bench/real_gnss_windows.py: above 1 m/s, 50-120 s each). Each window is
 # simulated once along the reference (camera and IMU; the street world) with the single-point
 # solution's real errors replayed (`gvio simulate --gnss-errors-from rover_1Hz_spp.pos`, no GNSS
-# lever arm), then run with SPP and with the 5 Hz RTK solution (`gvio run --gnss-file
-# rover_rtk.pos`: with no lever arm, replaying a solution along its own reference gives back the
-# solution to within the trajectory fit, 2 mm RMS) by the graph fusion (its smoothed
+# lever arm), then run with the SPP and with the 5 Hz RTK solution as the receiver wrote them
+# (`gvio run --gnss-file rover_1Hz_spp.pos` or `rover_rtk.pos`: with no lever arm, replaying a
+# solution along its own reference gives back the solution to within the trajectory fit, 2 mm RMS;
+# read from the .pos, every field RTKLIB states is fused, the error ellipse included; compare
+# BENCH_SET=dataset.gnss_ellipse=circle) by the graph fusion (its smoothed
 # trajectory.tum and causal trajectory_online.tum) and the paper's Kalman filter (--gnss kf).
 # Everything is evaluated against the reference by `gvio eval` (horizontal and vertical errors in
 # ENU, --errors-csv) and tabled by tests/bench/real_gnss_table.py: per window and solution the raw
@@ -73,14 +75,13 @@ if [ -z "${BENCH_TABLE_ONLY:-}" ]; then
     for sol in $SOLUTIONS; do
       "$GVIO" eval --ref "$cell/reference.csv" --est "${SOLUTION_FILE[$sol]}" \
         --errors-csv "$cell/$sol.fixes.errors.csv" > "$cell/$sol.fixes.eval.log" 2>&1 || true
-      gnss_file=()
-      [ "$sol" = spp ] || gnss_file=(--gnss-file "${SOLUTION_FILE[$sol]}")
+      gnss_file=(--gnss-file "${SOLUTION_FILE[$sol]}")
       for fusion in $FUSIONS; do
         run="$cell/$sol.$fusion"
         rm -rf "$run"
         echo "bench: $name: $sol $fusion" >&2
         rc=0
-        "$GVIO" run --dataset "$cache" --gnss "$fusion" ${gnss_file[@]+"${gnss_file[@]}"} \
+        "$GVIO" run --dataset "$cache" --gnss "$fusion" "${gnss_file[@]}" \
           --set map.enabled=false ${RUN_SET[@]+"${RUN_SET[@]}"} --out "$run" --no-progress \
           > "$cell/$sol.$fusion.log" 2>&1 || rc=$?
         echo "$rc" > "$cell/$sol.$fusion.rc"

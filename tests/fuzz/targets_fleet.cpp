@@ -85,6 +85,8 @@ void writeKeyframesBin(const fs::path& file) {
   f.node = 1;
   f.t_ns = 2'000'000'000;
   f.p_enu = Eigen::Vector3d(5.0, 0.1, 0.8);
+  f.quality = 5;
+  f.shape_en << 1.2, 0.3, 0.3, 0.8;  // a stated ellipse (keyframes.bin version 3)
   db.fixes.push_back(f);
   fusion::GraphLoop l;
   l.i = 0;
@@ -135,6 +137,9 @@ void addFleetTargets(std::vector<Target>& out) {
         }
         for (const auto& f : db.fixes) {
           require(f.node < db.keyframes.size(), "fix off the keyframes");
+          require(
+              f.shape_en.allFinite() && f.shape_en(0, 0) > 0.0 && f.shape_en.determinant() > 0.0,
+              "fix ellipse not positive definite");
         }
       },
       ""});

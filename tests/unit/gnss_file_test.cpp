@@ -91,6 +91,28 @@ TEST(RtklibPos, LatLonHeightInGpstWithQualitiesAndSigmaFloors) {
   EXPECT_EQ(nmeaQualityOfRtklibQ(6), 5);
 }
 
+// RTKLIB's sdne (sign(c) sqrt(|c|) of the north-east covariance) with sdn and sde: the fix's
+// ellipse. dataset.gnss_ellipse: circle leaves each fix a circle of the same horizontal sigma.
+TEST(RtklibPos, TheNorthEastCorrelationGivesTheShape) {
+  test::TempDir dir("pos_sdne");
+  const fs::path file = dir.path() / "drive.pos";
+  test::writeText(file, std::string(kLlhHeader) +
+                            "2011/10/03 12:55:49.000   48.982537273    8.390351723   114.9085   5"
+                            "  11   2.0000   1.0000   3.5000   1.0000   0.0000   0.0000   0.00    "
+                            "0.0\n"
+                            "2011/10/03 12:55:50.000   48.982537300    8.390351800   115.0000   5"
+                            "  11   2.0000   1.0000   3.5000  -1.0000   0.5000  -0.5000   0.00    "
+                            "0.0\n");
+  const PosFile pos = readRtklibPos(file, ReaderConfig{});
+  ASSERT_EQ(pos.fixes.size(), 2U);
+  // cov_en = [1 1; 1 4] (sde^2, sdne^2; sdne^2, sdn^2): trace 5, rho 0.5.
+  Eigen::Matrix2d expected;
+  expected << 2.0 / 5.0, 2.0 / 5.0, 2.0 / 5.0, 8.0 / 5.0;
+  EXPECT_LT((pos.fixes[0].shape_en - expected).norm(), 1e-12);
+  EXPECT_NEAR(pos.fixes[0].sigma_h_m, std::sqrt(2.5), 1e-12);
+  EXPECT_NEAR(pos.fixes[1].shape_en(0, 1), -2.0 / 5.0, 1e-12);  // a negative sdne
+}
+
 TEST(RtklibPos, EcefWithWeekAndSecondsOfWeek) {
   const fusion::Lla lla{48.98253, 8.39035, 116.4};
   const Eigen::Vector3d p = fusion::llaToEcef(lla);
@@ -249,7 +271,8 @@ TEST(CliGnssFile, APosFileGivesTheSameRunAsTheSameFixesInCsv) {
   const fs::path csv = drive / "gnss" / "data.csv";
   test::TempDir dir("cli_gnss_file");
   // The CSV's fixes as an RTKLIB single-point solution in GPST.
-  std::string pos = kLlhHeader;
+  // And the same with a north-east correlation of 0.49 (sdne = 0.7 sdn, sdn = sde).
+  std::string pos = kLlhHeader, correlated = kLlhHeader;
   LineReader in(csv);
   std::string line;
   while (in.next(line)) {
@@ -259,17 +282,21 @@ TEST(CliGnssFile, APosFileGivesTheSameRunAsTheSameFixesInCsv) {
     const std::int64_t t_utc = parseInt64(f[0], in, "t");
     const std::int64_t t_gpst = t_utc + gpsMinusUtcSeconds(t_utc) * kS;  // no leap second near
     const std::string stamp = formatKittiTimestamp(t_gpst);  // "YYYY-MM-DD hh:mm:ss.fffffffff"
-    pos += fmt::format("{}/{}/{} {} {} {} {} 5 10 {} {} {} 0 0 0 0 0\n", stamp.substr(0, 4),
-                       stamp.substr(5, 2), stamp.substr(8, 2), stamp.substr(11), f[1], f[2], f[3],
-                       f[4], f[4], f[5]);
+    const std::string head =
+        fmt::format("{}/{}/{} {} {} {} {} 5 10 {} {} {}", stamp.substr(0, 4), stamp.substr(5, 2),
+                    stamp.substr(8, 2), stamp.substr(11), f[1], f[2], f[3], f[4], f[4], f[5]);
+    pos += head + " 0 0 0 0 0\n";
+    correlated += fmt::format("{} {:.4f} 0 0 0 0\n", head, 0.7 * std::stod(std::string(f[4])));
   }
   test::writeText(dir.path() / "fixes.pos", pos);
-  const auto run = [&](const fs::path& gnss_file, const std::string& out) {
+  test::writeText(dir.path() / "correlated.pos", correlated);
+  const auto run = [&](const fs::path& gnss_file, const std::string& out,
+                       const std::string& extra = "") {
     return test::runGvio(
         fmt::format("run --dataset {} --out {} --no-progress --gnss graph --gnss-file {} --set "
-                    "map.enabled=false --set loops.enabled=false {}",
+                    "map.enabled=false --set loops.enabled=false {} {}",
                     test::quoted(drive), test::quoted(dir.path() / out), test::quoted(gnss_file),
-                    test::kSimGeo));
+                    test::kSimGeo, extra));
   };
   const test::CommandResult from_csv = run(csv, "csv");
   ASSERT_EQ(from_csv.exit_code, 0) << from_csv.err;
@@ -280,6 +307,14 @@ TEST(CliGnssFile, APosFileGivesTheSameRunAsTheSameFixesInCsv) {
   EXPECT_EQ(fused, test::readText(dir.path() / "csv" / "trajectory.tum"));
   EXPECT_EQ(test::readText(dir.path() / "pos" / "gnss_fixes.csv"),
             test::readText(dir.path() / "csv" / "gnss_fixes.csv"));
+  // The stated ellipses are fused (another trajectory); as circles, the same run as the CSV's.
+  const test::CommandResult ellipses = run(dir.path() / "correlated.pos", "ellipses");
+  ASSERT_EQ(ellipses.exit_code, 0) << ellipses.err;
+  EXPECT_NE(test::readText(dir.path() / "ellipses" / "trajectory.tum"), fused);
+  const test::CommandResult circles =
+      run(dir.path() / "correlated.pos", "circles", "--set dataset.gnss_ellipse=circle");
+  ASSERT_EQ(circles.exit_code, 0) << circles.err;
+  EXPECT_EQ(test::readText(dir.path() / "circles" / "trajectory.tum"), fused);
 
   test::writeText(dir.path() / "bad.pos", "%  GPST  e-baseline(m) n-baseline(m)\n1 2 3\n");
   const test::CommandResult bad = run(dir.path() / "bad.pos", "bad");

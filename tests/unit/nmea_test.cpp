@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "fusion/gnss_covariance.hpp"
 #include "io/input_error.hpp"
 
 namespace gvio::io {
@@ -263,6 +264,29 @@ TEST_F(NmeaTest, GstSigmasAreUsedForTheirEpoch) {
   EXPECT_NEAR(log.fixes[0].sigma_v_m, 0.9, 1e-12);
   // No GST for the second epoch: the HDOP model applies.
   EXPECT_NEAR(log.fixes[1].sigma_h_m, 0.9 * config_.nmea_uere_spp_m, 1e-12);
+}
+
+// GST's error ellipse (semi-major, semi-minor, orientation of the major axis from true north)
+// gives the fix's shape; receivers that leave it empty or zero state a circle.
+TEST_F(NmeaTest, GstEllipseGivesTheShape) {
+  const NmeaLog log =
+      read({rmc("120000", "010124"), gga("120000"),
+            withNmeaChecksum("GPGST,120000,1.2,3.0,1.0,45.0,2.24,2.24,4.0"), gga("120001"),
+            withNmeaChecksum("GPGST,120001,1.2,,,,2.0,1.0,4.0"), gga("120002"),
+            withNmeaChecksum("GPGST,120002,1.2,0.0,0.0,0.0,2.0,1.0,4.0")});
+  ASSERT_EQ(log.fixes.size(), 3u);
+  const Eigen::Matrix2d expected =
+      fusion::horizontalShape(fusion::ellipseCovariance(3.0, 1.0, 45.0));
+  EXPECT_LT((log.fixes[0].shape_en - expected).norm(), 1e-12);
+  EXPECT_NEAR(log.fixes[0].shape_en(0, 1), 0.8, 1e-12);  // (9 - 1) / 2 over trace / 2 = 5
+  EXPECT_NEAR(log.fixes[0].sigma_h_m, 2.24, 1e-12);      // from the latitude/longitude sigmas
+  EXPECT_EQ(log.fixes[1].shape_en, Eigen::Matrix2d::Identity());
+  EXPECT_EQ(log.fixes[2].shape_en, Eigen::Matrix2d::Identity());
+  const std::string error =
+      errorOf({rmc("120000", "010124"), gga("120000"),
+               withNmeaChecksum("GPGST,120000,1.2,3.0,1.0,north,2.0,1.0,4.0")});
+  EXPECT_NE(error.find(fileAt(3)), std::string::npos) << error;
+  EXPECT_NE(error.find("ellipse orientation"), std::string::npos) << error;
 }
 
 TEST_F(NmeaTest, GstFromAnotherTalkerBeforeTheGgaCounts) {

@@ -60,6 +60,7 @@ mapping::PlaceDatabase makeDatabase() {
   f.sigma_h_m = 1.5;
   f.sigma_v_m = 3.0;
   f.quality = 4;
+  f.shape_en << 1.4, 0.3, 0.3, 0.6;
   db.fixes.push_back(f);
   fusion::GraphLoop l;
   l.i = 0;
@@ -106,6 +107,7 @@ TEST(PlaceDatabaseIo, WrittenAndReadBackExactly) {
   EXPECT_EQ(back.fixes[0].p_enu, db.fixes[0].p_enu);
   EXPECT_EQ(back.fixes[0].sigma_v_m, 3.0);
   EXPECT_EQ(back.fixes[0].quality, 4);
+  EXPECT_EQ(back.fixes[0].shape_en, db.fixes[0].shape_en);
   ASSERT_EQ(back.loops.size(), 1U);
   EXPECT_EQ(back.loops[0].j, 2U);
   EXPECT_EQ(back.loops[0].covariance, db.loops[0].covariance);
@@ -148,19 +150,27 @@ TEST(PlaceDatabaseIo, DamageIsRefusedWithItsByteOffset) {
   std::memcpy(skew.data() + 8 + 4 + 4 + 4 + 4 + 4 * 8, &two, 8);
   refused(skew, "a pose whose rotation is not a rotation");
   EXPECT_THROW(readPlaceDatabase(dir.path() / "missing.bin"), InputError);
-  // The fix's quality (version 2) out of NMEA's range; a version not yet written.
-  const std::size_t quality_at = good.size() - (2 * 8 + 48 * 8) - 4;  // before the one loop
+  // The fix's quality (version 2) out of NMEA's range, its ellipse (version 3) not one; a version
+  // not yet written.
+  const std::size_t loop_bytes = 2 * 8 + 48 * 8;
+  const std::size_t shape_at = good.size() - loop_bytes - 3 * 8;  // before the one loop
+  const std::size_t quality_at = shape_at - 4;
   std::string bad_quality = good;
   const std::int32_t twelve = 12;
   std::memcpy(bad_quality.data() + quality_at, &twelve, 4);
   refused(bad_quality, "a fix quality that is not 0..9");
+  std::string bad_shape = good;
+  const double thin = 1.3;  // en: |0.3| -> 1.3 > sqrt(1.4 x 0.6)
+  std::memcpy(bad_shape.data() + shape_at + 16, &thin, 8);
+  refused(bad_shape, "a fix ellipse shape that is not positive definite with trace 2");
   std::string future = good;
-  const std::uint32_t three = 3;
-  std::memcpy(future.data() + 8, &three, 4);
+  const std::uint32_t four = 4;
+  std::memcpy(future.data() + 8, &four, 4);
   refused(future, "a version this gvio does not read");
 }
 
-// Files written before the fix quality (version 1) are still read, their fixes as quality 1.
+// Files written before the fix quality (version 1) are still read, their fixes as quality 1, and
+// those before the ellipse (versions 1 and 2) with circular fixes.
 TEST(PlaceDatabaseIo, VersionOneIsReadWithSinglePointFixes) {
   const test::TempDir dir("place_db_v1");
   const fs::path file = dir.path() / "keyframes.bin";
@@ -168,13 +178,22 @@ TEST(PlaceDatabaseIo, VersionOneIsReadWithSinglePointFixes) {
   std::string v1 = bytesOf(file);
   const std::uint32_t one = 1;
   std::memcpy(v1.data() + 8, &one, 4);
-  v1.erase(v1.size() - (2 * 8 + 48 * 8) - 4, 4);
+  v1.erase(v1.size() - (2 * 8 + 48 * 8) - 3 * 8 - 4, 3 * 8 + 4);
   const mapping::PlaceDatabase back = parsePlaceDatabase(v1, file);
   ASSERT_EQ(back.fixes.size(), 1U);
   EXPECT_EQ(back.fixes[0].quality, 1);
+  EXPECT_EQ(back.fixes[0].shape_en, Eigen::Matrix2d::Identity());
   EXPECT_EQ(back.fixes[0].sigma_v_m, 3.0);
   ASSERT_EQ(back.loops.size(), 1U);
   EXPECT_EQ(back.loops[0].covariance, makeDatabase().loops[0].covariance);
+  std::string v2 = bytesOf(file);
+  const std::uint32_t two = 2;
+  std::memcpy(v2.data() + 8, &two, 4);
+  v2.erase(v2.size() - (2 * 8 + 48 * 8) - 3 * 8, 3 * 8);
+  const mapping::PlaceDatabase back2 = parsePlaceDatabase(v2, file);
+  ASSERT_EQ(back2.fixes.size(), 1U);
+  EXPECT_EQ(back2.fixes[0].quality, 4);
+  EXPECT_EQ(back2.fixes[0].shape_en, Eigen::Matrix2d::Identity());
 }
 
 }  // namespace

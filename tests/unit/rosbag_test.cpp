@@ -204,8 +204,10 @@ TEST(Rosbag, NavSatFixStatusAndCovarianceToQualityAndSigmas) {
     w.write("/fix", fix(kT0 + 2'000'000'000, 0, 2.5, 0));   // covariance unknown
     w.write("/fix", fix(kT0 + 3'000'000'000, 2, 0.02, 3));  // GBAS, centimetre: RTK fixed
     w.write("/fix", fix(kT0 + 4'000'000'000, 2, 0.4, 3));   // GBAS, decimetre: RTK float
-    w.write("/fix", fix(kT0 + 5'000'000'000, 1, 0.8, 1));   // SBAS
-    auto off_globe = fix(kT0 + 6'000'000'000, 0, 2.5, 2);   // longitude 200 deg: skipped
+    auto sbas = fix(kT0 + 5'000'000'000, 1, 0.8, 1);  // SBAS: approximated, no correlation read
+    sbas.covariance_enu_m2[1] = sbas.covariance_enu_m2[3] = 0.3;
+    w.write("/fix", sbas);
+    auto off_globe = fix(kT0 + 6'000'000'000, 0, 2.5, 2);  // longitude 200 deg: skipped
     off_globe.lon_deg = 200.0;
     w.write("/fix", off_globe);
     auto below_pole = fix(kT0 + 7'000'000'000, 0, 2.5, 2);  // latitude -91 deg: skipped
@@ -224,9 +226,28 @@ TEST(Rosbag, NavSatFixStatusAndCovarianceToQualityAndSigmas) {
   EXPECT_DOUBLE_EQ(ds.gnss[2].sigma_h_m, 0.02);
   EXPECT_EQ(ds.gnss[3].quality, 5);
   EXPECT_EQ(ds.gnss[4].quality, 2);
+  EXPECT_EQ(ds.gnss[4].shape_en, Eigen::Matrix2d::Identity());
   EXPECT_DOUBLE_EQ(ds.gnss[0].h_ellipsoid_m, 116.0);
   EXPECT_EQ(ds.gnss_source, file.string() + ":/fix");
   EXPECT_THAT(ds.warnings.front(), HasSubstr("3 messages without a fix skipped"));
+}
+
+// A NavSatFix whose covariance is known in full (type 3) states its east-north correlation: the
+// fix's ellipse.
+TEST(Rosbag, AKnownCovarianceGivesTheEllipse) {
+  test::TempDir dir("rosbag");
+  const fs::path file = writeBag(dir.path() / "gnss.bag", bag::Compression::kNone, [](auto& w) {
+    auto known = fix(kT0, 0, 2.0, 3);
+    known.covariance_enu_m2[0] = 9.0;                                // east 3 m
+    known.covariance_enu_m2[1] = known.covariance_enu_m2[3] = -1.2;  // rho -0.4
+    w.write("/fix", known);
+  });
+  const Dataset ds = readDataset(file, std::nullopt, ReaderConfig{});
+  ASSERT_EQ(ds.gnss.size(), 1U);
+  Eigen::Matrix2d cov;
+  cov << 9.0, -1.2, -1.2, 4.0;
+  EXPECT_LT((ds.gnss[0].shape_en - 2.0 * cov / cov.trace()).norm(), 1e-12);
+  EXPECT_DOUBLE_EQ(ds.gnss[0].sigma_h_m, std::sqrt(6.5));
 }
 
 TEST(Rosbag, BrokenBagsAreOneLineErrorsNamingTheBag) {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "fusion/gnss_covariance.hpp"
 #include "io/nmea.hpp"
 #include "io/reader_config.hpp"
 #include "io/rtklib_pos.hpp"
@@ -338,6 +339,38 @@ TEST(SimGnss, RtklibPosRoundTrip) {
     // Read sigmas are floored by the quality's UERE (io/rtklib_pos.hpp), never lowered.
     EXPECT_GE(read.fixes[i].sigma_h_m, fixes[i].sigma_h_m - 1e-4);
   }
+}
+
+// A replayed receiver's error ellipse survives the files gvio simulate writes: NMEA GST (its axes
+// and orientation, written exactly) and RTKLIB's sdn/sde/sdne (4 decimals).
+TEST(SimGnss, EllipsesRoundTripThroughNmeaAndPos) {
+  std::vector<GnssFix> fixes = reported(simulate(GnssNoise::kSpp, 1.0, 5.5));
+  ASSERT_EQ(fixes.size(), 6u);
+  for (std::size_t i = 0; i < fixes.size(); ++i) {
+    fixes[i].sigma_h_m = 2.0 + 0.5 * static_cast<double>(i);
+    fixes[i].shape_en = fusion::horizontalShape(
+        fusion::ellipseCovariance(3.0, 1.0, 35.0 * static_cast<double>(i)));  // 0..175 deg
+  }
+  fixes[2].shape_en.setIdentity();  // a circle stays one
+  const fs::path dir =
+      fs::temp_directory_path() / ("gvio_sim_ellipse_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "fixes.nmea", std::ios::binary) << toNmeaLog(fixes);
+  std::ofstream(dir / "fixes.pos", std::ios::binary) << toRtklibPos(fixes);
+  const io::NmeaLog nmea = io::readNmea(dir / "fixes.nmea", io::ReaderConfig{});
+  const io::PosFile pos = io::readRtklibPos(dir / "fixes.pos", io::ReaderConfig{});
+  fs::remove_all(dir);
+  ASSERT_EQ(nmea.fixes.size(), fixes.size());
+  ASSERT_EQ(pos.fixes.size(), fixes.size());
+  for (std::size_t i = 0; i < fixes.size(); ++i) {
+    EXPECT_NEAR(nmea.fixes[i].sigma_h_m, fixes[i].sigma_h_m, 1e-12) << i;
+    EXPECT_LT((nmea.fixes[i].shape_en - fixes[i].shape_en).norm(), 1e-9) << i;
+    EXPECT_NEAR(pos.fixes[i].sigma_h_m, fixes[i].sigma_h_m, 1e-4) << i;
+    EXPECT_LT((pos.fixes[i].shape_en - fixes[i].shape_en).norm(), 1e-3) << i;
+  }
+  EXPECT_EQ(nmea.fixes[2].shape_en, Eigen::Matrix2d::Identity());
+  EXPECT_GT(nmea.fixes[1].shape_en(0, 1), 0.1);   // 35 deg: east and north errors go together
+  EXPECT_LT(nmea.fixes[4].shape_en(0, 1), -0.1);  // 140 deg: they go apart
 }
 
 TEST(SimGnss, GnssCsvFormat) {
