@@ -8,7 +8,8 @@ wrote (--errors-csv: t_s, ape, dx_m = east, dy_m = north, ...), per RTKLIB quali
   below 0 the ellipse describes the error better (a median: formal sigmas far too small make
   the means a few epochs' matter);
 - the fraction of the squared error that lies along the stated major axis, beside what the
-  ellipses themselves predict (their mean major-axis variance share); 0.5 = no relation;
+  ellipses themselves predict for it: for a Gaussian error of axis sigmas s1 >= s2,
+  E[e1^2 / (e1^2 + e2^2)] = s1 / (s1 + s2); 0.5 = no relation;
 - the median |rho_ne| the solution states.
 
     gvio eval --ref reference.csv --est rover_1Hz_spp.pos --errors-csv spp_errors.csv
@@ -89,7 +90,9 @@ def main(pos_path, errors_path):
             norm2 = e[0] ** 2 + e[1] ** 2
             per_q.setdefault(q, []).append(
                 (0.5 * (d_ell + math.log(det_ell)), 0.5 * (d_circ + math.log(det_circ)),
-                 along / norm2 if norm2 > 0 else 0.5, major / (a + b), abs(c) / math.sqrt(a * b)))
+                 along / norm2 if norm2 > 0 else 0.5,
+                 math.sqrt(major) / (math.sqrt(major) + math.sqrt(max(a + b - major, 0.0))),
+                 abs(c) / math.sqrt(a * b)))
     if not per_q:
         sys.exit(f"{errors_path}: no epoch matches {pos_path}")
     print("| Q | epochs | median NLL, ellipse - circle | error share on the major axis | "
