@@ -73,11 +73,6 @@ GnssPositionFactor::GnssPositionFactor(const Eigen::Vector3d& q_b, const Eigen::
                                        const Eigen::Matrix3d& sqrt_information)
     : q_b_(q_b), p_fix_(p_enu_fix), sqrt_info_(sqrt_information) {}
 
-GnssPositionFactor::GnssPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix,
-                                       double sigma_h_m, double sigma_v_m)
-    : GnssPositionFactor(q_b, p_enu_fix,
-                         gnssSqrtInformation(sigma_h_m, sigma_v_m, Eigen::Matrix2d::Identity())) {}
-
 bool GnssPositionFactor::Evaluate(double const* const* parameters, double* residuals,
                                   double** jacobians) const {
   const Eigen::Matrix3d R = poseQ(parameters[0]).normalized().toRotationMatrix();
@@ -95,22 +90,17 @@ bool GnssPositionFactor::Evaluate(double const* const* parameters, double* resid
 GnssBiasedPositionFactor::GnssBiasedPositionFactor(const Eigen::Vector3d& q_b,
                                                    const Eigen::Vector3d& p_enu_fix,
                                                    const Eigen::Matrix3d& sqrt_information)
-    : position_(q_b, p_enu_fix, sqrt_information), sqrt_info_(sqrt_information) {}
-
-GnssBiasedPositionFactor::GnssBiasedPositionFactor(const Eigen::Vector3d& q_b,
-                                                   const Eigen::Vector3d& p_enu_fix,
-                                                   double sigma_h_m, double sigma_v_m)
-    : GnssBiasedPositionFactor(
-          q_b, p_enu_fix, gnssSqrtInformation(sigma_h_m, sigma_v_m, Eigen::Matrix2d::Identity())) {}
+    : position_(q_b, p_enu_fix, sqrt_information) {}
 
 bool GnssBiasedPositionFactor::Evaluate(double const* const* parameters, double* residuals,
                                         double** jacobians) const {
   double* pose_jacobian[1] = {jacobians != nullptr ? jacobians[0] : nullptr};
   position_.Evaluate(parameters, residuals, jacobians != nullptr ? pose_jacobian : nullptr);
   const Eigen::Map<const Eigen::Vector3d> b(parameters[1]);
-  Eigen::Map<Eigen::Vector3d>{residuals} += sqrt_info_ * b;
+  Eigen::Map<Eigen::Vector3d>{residuals} += position_.sqrtInformation() * b;
   if (jacobians != nullptr && jacobians[1] != nullptr) {
-    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>{jacobians[1]} = sqrt_info_;
+    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>{jacobians[1]} =
+        position_.sqrtInformation();
   }
   return true;
 }

@@ -45,10 +45,9 @@ class GnssPositionFactor final : public ceres::SizedCostFunction<3, 7> {
  public:
   GnssPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix,
                      const Eigen::Matrix3d& sqrt_information);
-  GnssPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix, double sigma_h_m,
-                     double sigma_v_m);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
+  [[nodiscard]] const Eigen::Matrix3d& sqrtInformation() const { return sqrt_info_; }
 
  private:
   Eigen::Vector3d q_b_, p_fix_;
@@ -61,14 +60,11 @@ class GnssBiasedPositionFactor final : public ceres::SizedCostFunction<3, 7, 3> 
  public:
   GnssBiasedPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix,
                            const Eigen::Matrix3d& sqrt_information);
-  GnssBiasedPositionFactor(const Eigen::Vector3d& q_b, const Eigen::Vector3d& p_enu_fix,
-                           double sigma_h_m, double sigma_v_m);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
  private:
-  GnssPositionFactor position_;
-  Eigen::Matrix3d sqrt_info_;
+  GnssPositionFactor position_;  // the same fix without the bias (and its W)
 };
 
 // First-order Gauss-Markov process between two bias states dt apart (Groves 2013, App. I):

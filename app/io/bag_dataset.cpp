@@ -198,19 +198,17 @@ void readGnss(const BagSource& reader, const std::string& topic, const ReaderCon
                         std::isfinite(cov[8]) && cov[0] > 0.0 && cov[4] > 0.0 && cov[8] > 0.0;
     const double stated_h = stated ? std::sqrt(0.5 * (cov[0] + cov[4])) : 0.0;
     fix.quality = m.status == 0 ? 1 : m.status == 1 ? 2 : (stated && stated_h < 0.1 ? 4 : 5);
-    const double floor_h = fix.quality == 4   ? config.nmea_uere_rtk_fixed_m
-                           : fix.quality == 5 ? config.nmea_uere_rtk_float_m
-                           : fix.quality == 2 ? config.nmea_uere_dgps_m
-                                              : config.nmea_uere_spp_m;
-    fix.sigma_h_m = std::max(stated_h, floor_h);
-    fix.sigma_v_m =
-        std::max(stated ? std::sqrt(cov[8]) : 0.0, floor_h * config.nmea_vertical_factor);
+    const double floor_h = config.uereM(fix.quality);
+    Eigen::Matrix2d cov_en = Eigen::Matrix2d::Zero();  // none stated: the floor's circle
     if (stated) {  // east-north correlation only where the whole covariance is known
       const double en = m.covariance_type == 3 && std::isfinite(cov[1]) ? cov[1] : 0.0;
-      fix.shape_en = fusion::flooredHorizontal(
-                         (Eigen::Matrix2d() << cov[0], en, en, cov[4]).finished(), floor_h)
-                         .shape_en;
+      cov_en << cov[0], en, en, cov[4];
     }
+    const fusion::HorizontalError h = fusion::flooredHorizontal(cov_en, floor_h);
+    fix.sigma_h_m = h.sigma_m;
+    fix.shape_en = h.shape_en;
+    fix.sigma_v_m =
+        std::max(stated ? std::sqrt(cov[8]) : 0.0, floor_h * config.nmea_vertical_factor);
     ds.gnss.push_back(fix);
   }
   use.used = ds.gnss.size();

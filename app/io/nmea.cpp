@@ -288,19 +288,6 @@ std::int64_t dayOf(const PendingFix& gga, const std::vector<RmcDate>& rmc,
   return after->day - (after->tod_ns < gga.tod_ns ? 1 : 0);
 }
 
-double uere(int quality, const ReaderConfig& config) {
-  switch (quality) {
-    case 2:
-      return config.nmea_uere_dgps_m;
-    case 4:
-      return config.nmea_uere_rtk_fixed_m;
-    case 5:
-      return config.nmea_uere_rtk_float_m;
-    default:
-      return config.nmea_uere_spp_m;
-  }
-}
-
 // GST sigmas of the same epoch when present, else HDOP x UERE (HDOP 1 when not reported).
 void setSigmas(GnssFix& fix, std::size_t line, std::int64_t tod_ns, const Collected& in,
                const ReaderConfig& config) {
@@ -314,7 +301,7 @@ void setSigmas(GnssFix& fix, std::size_t line, std::int64_t tod_ns, const Collec
     return;
   }
   const double hdop = fix.hdop > 0.0 ? fix.hdop : 1.0;
-  fix.sigma_h_m = hdop * uere(fix.quality, config);
+  fix.sigma_h_m = hdop * config.uereM(fix.quality);
   fix.sigma_v_m = fix.sigma_h_m * config.nmea_vertical_factor;
 }
 

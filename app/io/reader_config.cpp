@@ -16,6 +16,19 @@ void requirePositive(double value, const char* key) {
 
 }  // namespace
 
+double ReaderConfig::uereM(int quality) const {
+  switch (quality) {
+    case 2:
+      return nmea_uere_dgps_m;
+    case 4:
+      return nmea_uere_rtk_fixed_m;
+    case 5:
+      return nmea_uere_rtk_float_m;
+    default:
+      return nmea_uere_spp_m;
+  }
+}
+
 void ReaderConfig::validate() const {
   if (kitti_gnss_source != "auto" && kitti_gnss_source != "nmea" && kitti_gnss_source != "oxts") {
     throw InvalidInput("config: dataset.kitti_gnss_source must be auto, nmea or oxts (got '" +

@@ -37,6 +37,9 @@ struct ReaderConfig {
   double stereo_sync_tolerance_s = 0.003;
 
   void validate() const;  // throws InvalidInput naming the key
+  // The 1-sigma horizontal UERE of an NMEA fix quality (the nmea_uere_* above; SPP for any
+  // quality not named there): NMEA's HDOP model, and the floor under a stated sigma.
+  [[nodiscard]] double uereM(int quality) const;
 };
 
 }  // namespace gvio::io

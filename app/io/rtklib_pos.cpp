@@ -219,10 +219,7 @@ PosFile readRtklibPos(const std::filesystem::path& file, const ReaderConfig& con
       fix.course_deg = std::fmod(std::atan2(v_enu.x(), v_enu.y()) * 180.0 / M_PI + 360.0, 360.0);
       ++out.with_velocity;
     }
-    const double floor_h = fix.quality == 4   ? config.nmea_uere_rtk_fixed_m
-                           : fix.quality == 5 ? config.nmea_uere_rtk_float_m
-                           : fix.quality == 2 ? config.nmea_uere_dgps_m
-                                              : config.nmea_uere_spp_m;
+    const double floor_h = config.uereM(fix.quality);
     const fusion::HorizontalError h =
         fusion::flooredHorizontal(cov_enu.topLeftCorner<2, 2>(), floor_h);
     fix.sigma_h_m = h.sigma_m;

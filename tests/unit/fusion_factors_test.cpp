@@ -45,12 +45,13 @@ TEST(GnssPositionFactor, ZeroAtTheAntennaAndJacobian) {
       poseBlock(Eigen::Vector3d(0.02, -0.01, 2.0), Eigen::Vector3d(100, 50, 3))};
   const Eigen::Isometry3d T = odometry::poseFromBlock(blocks[0].data());
   const Eigen::Vector3d q_b(1.2, 0.3, 1.5);
-  const GnssPositionFactor exact(q_b, T * q_b, 1.5, 3.0);
+  const Eigen::Matrix3d W = gnssSqrtInformation(1.5, 3.0, Eigen::Matrix2d::Identity());
+  const GnssPositionFactor exact(q_b, T * q_b, W);
   const double* params[] = {blocks[0].data()};
   Eigen::Vector3d r;
   ASSERT_TRUE(exact.Evaluate(params, r.data(), nullptr));
   EXPECT_LT(r.norm(), 1e-9);
-  const GnssPositionFactor off(q_b, T * q_b + Eigen::Vector3d(1.5, 0.0, 3.0), 1.5, 3.0);
+  const GnssPositionFactor off(q_b, T * q_b + Eigen::Vector3d(1.5, 0.0, 3.0), W);
   ASSERT_TRUE(off.Evaluate(params, r.data(), nullptr));
   EXPECT_LT((r - Eigen::Vector3d(-1, 0, -1)).norm(), 1e-9);  // whitened per axis
   const auto num = numericTangentJacobian<3>(off, blocks, 0, true);
@@ -93,12 +94,13 @@ TEST(GnssBiasedPositionFactor, ZeroAtTheBiasedAntennaAndJacobians) {
   const Eigen::Isometry3d T = odometry::poseFromBlock(blocks[0].data());
   const Eigen::Vector3d q_b(1.2, 0.3, 1.5);
   const Eigen::Vector3d b(blocks[1][0], blocks[1][1], blocks[1][2]);
-  const GnssBiasedPositionFactor exact(q_b, T * q_b + b, 1.5, 3.0);
+  const Eigen::Matrix3d W = gnssSqrtInformation(1.5, 3.0, Eigen::Matrix2d::Identity());
+  const GnssBiasedPositionFactor exact(q_b, T * q_b + b, W);
   const double* params[] = {blocks[0].data(), blocks[1].data()};
   Eigen::Vector3d r;
   ASSERT_TRUE(exact.Evaluate(params, r.data(), nullptr));
   EXPECT_LT(r.norm(), 1e-9);
-  const GnssBiasedPositionFactor off(q_b, T * q_b + b + Eigen::Vector3d(1.5, 0.0, 3.0), 1.5, 3.0);
+  const GnssBiasedPositionFactor off(q_b, T * q_b + b + Eigen::Vector3d(1.5, 0.0, 3.0), W);
   ASSERT_TRUE(off.Evaluate(params, r.data(), nullptr));
   EXPECT_LT((r - Eigen::Vector3d(-1, 0, -1)).norm(), 1e-9);
   for (std::size_t k = 0; k < 2; ++k) {

@@ -59,6 +59,10 @@ TEST(GnssCovariance, AFloorAddsACircle) {
   const Ellipse e = ellipseOf(floored.shape_en);
   EXPECT_GT(e.minor_m / e.major_m, 0.95);  // nearly a circle
   EXPECT_NEAR(e.orientation_deg, 30.0, 1e-6);
+  // Nothing stated: a circle of the floor, exactly.
+  const HorizontalError none = flooredHorizontal(Eigen::Matrix2d::Zero(), 1.5);
+  EXPECT_EQ(none.sigma_m, 1.5);
+  EXPECT_EQ(none.shape_en, Eigen::Matrix2d::Identity());
   const Eigen::Matrix2d big = ellipseCovariance(3.0, 1.0, 30.0);
   const HorizontalError kept = flooredHorizontal(big, 1.5);
   EXPECT_DOUBLE_EQ(kept.sigma_m, std::sqrt(5.0));
