@@ -225,15 +225,12 @@ bool GnssFusion::Impl::fuseKf(const Pair& pair) {
   const auto covariance = [&](const GnssFix& fix) -> Eigen::Matrix3d {
     return gnssCovariance(fix.sigma_h_m * scale.x(), fix.sigma_v_m * scale.y(), fix.shape_en);
   };
-  const auto stated = [](const GnssFix& fix) -> Eigen::Vector3d {
-    return {fix.sigma_h_m * fix.sigma_h_m, fix.sigma_h_m * fix.sigma_h_m,
-            fix.sigma_v_m * fix.sigma_v_m};
-  };
   KfBaseline::Vector6d z;
   KfBaseline::Matrix6d R = KfBaseline::Matrix6d::Zero();
   const Eigen::Matrix3d cov_p = covariance(pair.fix);
   double dt_prev = 0.0;
   GnssFix prev_fix;
+  Eigen::Vector2d vio_step_en = Eigen::Vector2d::Zero();
   z.head<3>() = pair.p_enu - p_vio;
   R.topLeftCorner<3, 3>() = cov_p;
   // No Doppler in the input: GNSS velocity by finite differences of consecutive fixes, against the
@@ -248,17 +245,22 @@ bool GnssFusion::Impl::fuseKf(const Pair& pair) {
       R.bottomRightCorner<3, 3>() = (cov_p + covariance(previous_fix->fix)) / (dt * dt);
       dt_prev = dt;
       prev_fix = previous_fix->fix;
+      vio_step_en = (p_vio - p_vio_prev).head<2>();
     }
   }
   previous_fix = pair;
   // What the receiver's noise is, from consecutive fixes: their displacement against the VIO's
-  // over at most kMaxNoiseDifferencingS, normalised by the stated sigmas of both, is free of the
-  // filter's own error (which would feed back: larger sigmas, a looser filter, larger
-  // innovations) and of the slow bias the differencing cancels.
+  // over at most kMaxNoiseDifferencingS, whitened by the stated covariances of both
+  // (differencedNoiseSample), is free of the slow bias the differencing cancels and, taken along
+  // the track, of the filter's own error (which would feed back: larger sigmas, a looser filter,
+  // larger innovations).
   if (config.kf.learn_noise && dt_prev > 0.0 && dt_prev <= kMaxNoiseDifferencingS) {
-    const Eigen::Vector3d both = stated(pair.fix) + stated(prev_fix);
-    const Eigen::Vector3d z2 = (z.tail<3>() * dt_prev).cwiseAbs2().cwiseQuotient(both);
-    kf_noise.add(pair.fix.quality, z2.head<2>(), z2.z());
+    const Eigen::Matrix3d both =
+        gnssCovariance(pair.fix.sigma_h_m, pair.fix.sigma_v_m, pair.fix.shape_en) +
+        gnssCovariance(prev_fix.sigma_h_m, prev_fix.sigma_v_m, prev_fix.shape_en);
+    const DifferencedNoiseSample sample =
+        differencedNoiseSample(z.tail<3>() * dt_prev, vio_step_en, both);
+    kf_noise.add(pair.fix.quality, sample.z2_horizontal, sample.z2_vertical);
   }
   KfBaseline candidate = kf;
   const double nis = candidate.update(z, R);

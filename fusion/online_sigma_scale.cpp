@@ -1,7 +1,9 @@
 #include "fusion/online_sigma_scale.hpp"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace gvio::fusion {
@@ -18,6 +20,26 @@ double medianOf(const std::deque<double>& d) {
 }
 
 }  // namespace
+
+DifferencedNoiseSample differencedNoiseSample(const Eigen::Vector3d& d_enu,
+                                              const Eigen::Vector2d& vio_step_en,
+                                              const Eigen::Matrix3d& cov_enu) {
+  DifferencedNoiseSample out;
+  out.z2_vertical = d_enu.z() * d_enu.z() / cov_enu(2, 2);
+  const Eigen::Matrix2d cov_h = cov_enu.topLeftCorner<2, 2>();
+  const double step_m = vio_step_en.norm();
+  if (step_m > kAlongTrackMinStepM) {
+    const Eigen::Vector2d along = vio_step_en / step_m;
+    const double u = along.dot(d_enu.head<2>());
+    out.z2_horizontal = {u * u / along.dot(cov_h * along),
+                         std::numeric_limits<double>::quiet_NaN()};
+  } else if (cov_h(0, 1) == 0.0) {  // a circle or an axis-aligned ellipse: per axis, exactly
+    out.z2_horizontal = d_enu.head<2>().cwiseAbs2().cwiseQuotient(cov_h.diagonal());
+  } else {
+    out.z2_horizontal = cov_h.llt().matrixL().solve(d_enu.head<2>()).cwiseAbs2();
+  }
+  return out;
+}
 
 void OnlineSigmaScale::add(int quality, const Eigen::Vector2d& z2_h, double z2_v) {
   Samples& s = samples_[quality];

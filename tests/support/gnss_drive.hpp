@@ -1,12 +1,14 @@
 #pragma once
 // A synthetic drive for the GNSS fusion tests: the truth, a drifting VIO in its own world, and
 // GNSS fixes with known errors (white noise, optional Gauss-Markov bias, outliers, an outage).
+#include <Eigen/Cholesky>
 #include <cmath>
 #include <cstdint>
 #include <random>
 #include <vector>
 
 #include "fusion/geodesy.hpp"
+#include "fusion/gnss_covariance.hpp"
 #include "fusion/gnss_fusion.hpp"
 #include "odometry/lie.hpp"
 #include "odometry/measurements.hpp"
@@ -86,6 +88,33 @@ inline GnssDrive makeGnssDrive(double outage_t0_s = -1, double outage_t1_s = -1,
     }
     d.fixes.push_back(fixAt(d.enu, t_ns, p, 1.5, 3.0));
     d.outlier.push_back(bad);
+  }
+  return d;
+}
+
+// The drive of makeGnssDrive with white fix errors drawn from thin ellipses (major_m x minor_m
+// 1-sigma semi-axes, vertical 3 m) whose orientation turns through 180 degrees every 150 fixes,
+// as a receiver's geometry turns; each fix states that ellipse with its horizontal sigma times
+// stated_factor (1: right; 0.5: optimistic by 2). No outliers.
+inline GnssDrive makeEllipseGnssDrive(std::uint64_t seed, double major_m = 3.0,
+                                      double minor_m = 0.5, double stated_factor = 1.0) {
+  GnssDrive d = makeGnssDrive();
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  for (std::size_t k = 0; k < d.fixes.size(); ++k) {
+    GnssFix& fix = d.fixes[k];
+    const double orientation_deg = 180.0 * static_cast<double>(k) / 150.0;
+    const Eigen::Matrix2d cov_en = fusion::ellipseCovariance(major_m, minor_m, orientation_deg);
+    // Draws sequenced: the order of a call's arguments is the compiler's choice.
+    const double w_e = n01(rng), w_n = n01(rng), w_u = n01(rng);
+    const Eigen::Vector2d e_en = cov_en.llt().matrixL() * Eigen::Vector2d(w_e, w_n);
+    const std::size_t pose = static_cast<std::size_t>(fix.t_ns / (kSecond / 10));
+    const Eigen::Vector3d p =
+        d.truth.poses[pose] * d.lever + Eigen::Vector3d(e_en.x(), e_en.y(), 3.0 * w_u);
+    fix = fixAt(d.enu, fix.t_ns, p, stated_factor * std::sqrt(cov_en.trace() / 2.0),
+                stated_factor * 3.0);
+    fix.shape_en = fusion::horizontalShape(cov_en);
+    d.outlier[k] = false;
   }
   return d;
 }
