@@ -132,7 +132,7 @@ if [ -n "$NOISE_K" ]; then
   echo "estimator's IMU noise: each drive's own (sim.yaml) x $NOISE_K (BENCH_IMU_NOISE)"
 fi
 python3 - "$OUT" "$CACHE_ROOT" "$DRIVE_S" "$IMU_RANGE" "$TRAJ_TAG" "$STYLES" "$SEEDS" "$MODES" <<'PY'
-import json, os, re, sys
+import json, math, os, re, sys
 out, cache_root, drive_s, imu_range, traj_tag = sys.argv[1:6]
 styles, seeds, modes = sys.argv[6].split(), sys.argv[7].split(), sys.argv[8].split()
 TARGET = 0.10  # % of the distance, stereo+IMU
@@ -231,6 +231,10 @@ if stereo_imu:
     shown = f"{p:.3f} %" if p != float("inf") else "failed"
     print(f"stereo-imu: {met} of {len(stereo_imu)} cells meet APE <= {TARGET:.2f} % of the path; "
           f"worst cell: {style} seed {seed} ({shown})")
+    finite = [p for p, _, _ in stereo_imu if p != float("inf")]
+    if finite:
+        geo = math.exp(sum(math.log(p) for p in finite) / len(finite))
+        print(f"stereo-imu: geometric mean APE {geo:.4f} % of the path over {len(finite)} cells")
 else:
     print("stereo-imu not in BENCH_MODES: no target line")
 PY
