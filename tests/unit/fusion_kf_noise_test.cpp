@@ -80,7 +80,7 @@ TEST(GnssFusionKf, ScreensOptimisticSigmasAsTheSmootherDoes) {
 // draw within 25 %), and with the right sigmas about 1. Normalised by the circle of the same
 // horizontal sigma instead, both axes' samples would learn about 1.56 and 0.78 (the short axes pull
 // the median down); whitened across the track too, the filter's heading error would enter
-// (learned 1.75-3.45 and up to 1.72 where 1 is right, on these drives).
+// (learned 1.75-3.45, and up to 1.72 where 1 is right, over six such drives).
 TEST(GnssFusionKf, LearnsTheScaleThroughTheStatedEllipses) {
   for (const std::uint64_t seed : {31u, 32u, 33u, 34u}) {
     const test::GnssDrive optimistic = test::makeEllipseGnssDrive(seed, 3.0, 0.5, 0.5);
