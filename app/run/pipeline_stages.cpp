@@ -8,6 +8,7 @@
 #include "io/place_database_io.hpp"
 #include "io/trajectory_io.hpp"
 #include "run/run_status.hpp"
+#include "run/time_offset_summary.hpp"
 
 namespace gvio::run {
 namespace {
@@ -152,7 +153,7 @@ void runMapStage(RunState& s) {
   }
   const MapPoseSource poses{s.final_trajectory.empty() ? nullptr : &s.final_trajectory,
                             &s.vio.trajectory,
-                            s.vio.time_offset_estimated ? s.vio.time_offset_s : 0.0};
+                            s.vio.time_offset_estimated ? vioTimeOffset(s.vio).t_d_s : 0.0};
   // Before the build frees the keyframes' dense points (beside the occupancy when threaded).
   nlohmann::json two_pass_report, revisits;
   const auto looks = [&] {

@@ -41,13 +41,13 @@ json evaluationJson(const EvaluationOutcome& outcome) {
 json timeOffsetJson(const io::Dataset& ds, const VioRunResult& run) {
   json history = json::array();
   for (const auto& [t_ns, t_d] : run.time_offset_history) history.push_back({seconds(t_ns), t_d});
+  const TimeOffsetSummary summary = vioTimeOffset(run);
   json j = {{"estimated", run.time_offset_estimated},
             {"calibration_timeshift_cam_imu_s", ds.camera_timeshift_s},
-            {"t_d_s", run.time_offset_s},
-            {"stamp_lag_s", run.time_offset_s - ds.camera_timeshift_s},
+            {"stamp_lag_s", summary.t_d_s - ds.camera_timeshift_s},
             {"held_solves", run.counters.time_offset_held_solves},
             {"history", history}};
-  j.update(timeOffsetSummaryJson(vioTimeOffset(run)));
+  j.update(timeOffsetSummaryJson(summary));
   return j;
 }
 

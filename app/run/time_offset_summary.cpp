@@ -21,6 +21,7 @@ TimeOffsetSummary summarizeTimeOffset(bool estimated, double t_d_s,
                                       const std::vector<double>& free_estimates, int held_solves) {
   TimeOffsetSummary s;
   s.t_d_s = t_d_s;
+  s.final_t_d_s = t_d_s;
   s.free_solves = static_cast<int>(free_estimates.size());
   s.held_solves = held_solves;
   const int solves = s.free_solves + s.held_solves;
@@ -37,6 +38,7 @@ TimeOffsetSummary summarizeTimeOffset(bool estimated, double t_d_s,
   s.status = "estimated";
   const std::vector<double> late(free_estimates.begin() + s.free_solves / 2, free_estimates.end());
   const double m = median(late);
+  s.t_d_s = m;
   std::vector<double> deviation;
   deviation.reserve(late.size());
   for (const double x : late) deviation.push_back(std::abs(x - m));
@@ -63,6 +65,8 @@ std::string timeOffsetText(const TimeOffsetSummary& s) {
 
 nlohmann::json timeOffsetSummaryJson(const TimeOffsetSummary& s) {
   nlohmann::json j = {{"status", s.status},
+                      {"t_d_s", s.t_d_s},
+                      {"t_d_final_s", s.final_t_d_s},
                       {"free_solves", s.free_solves},
                       {"observed_fraction", s.observed_fraction}};
   j["sigma_s"] = s.status == "estimated" ? nlohmann::json(s.sigma_s) : nlohmann::json(nullptr);

@@ -42,7 +42,8 @@ struct VioRunResult {
   std::size_t imu_samples = 0, gnss_fixes = 0;
   std::vector<odometry::VioEvent> events;
   // The camera-IMU time offset estimate (vio.estimate_time_offset with an IMU): its value at the
-  // end and once per second of the drive (frame stamp, estimate), both in seconds.
+  // end and once per second of the drive (frame stamp, estimate), both in seconds. What the run
+  // reports and retimes the map with is run/time_offset_summary's, from the free estimates.
   bool time_offset_estimated = false;
   double time_offset_s = 0.0;
   std::vector<std::pair<std::int64_t, double>> time_offset_history;
