@@ -9,14 +9,8 @@
 #   tests/bench/rss_kitti00.sh [OUT]        # OUT defaults to build/bench_rss
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-BUILD_DIR="${BUILD_DIR:-build}"
-GVIO="$BUILD_DIR/app/gvio"
-CACHE="${GVIO_BENCH_CACHE:-$BUILD_DIR/bench_cache}/kitti00_full_seed1"
+source tests/bench/kitti00_cache.sh
 OUT="${1:-$BUILD_DIR/bench_rss}"
-if [ ! -f "$CACHE/sim.yaml" ]; then
-  echo "bench: $CACHE absent: run tests/bench/vio_kitti00.sh once to simulate KITTI-00" >&2
-  exit 0
-fi
 mkdir -p "$OUT"
 
 # run NAME [gvio run options...]: samples "t_s,rss_mib,frames_done" into OUT/rss_NAME.csv.

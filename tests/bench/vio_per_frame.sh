@@ -11,14 +11,8 @@
 #   tests/bench/vio_per_frame.sh [OUT]        # OUT defaults to out/bench/vio_per_frame
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-BUILD_DIR="${BUILD_DIR:-build}"
-GVIO="$BUILD_DIR/app/gvio"
-CACHE="${GVIO_BENCH_CACHE:-$BUILD_DIR/bench_cache}/kitti00_full_seed1"
+source tests/bench/kitti00_cache.sh
 OUT="${1:-out/bench/vio_per_frame}"
-if [ ! -f "$CACHE/sim.yaml" ]; then
-  echo "bench: $CACHE absent: run tests/bench/vio_kitti00.sh once to simulate KITTI-00" >&2
-  exit 0
-fi
 [ -x "$GVIO" ] || { echo "bench: $GVIO not built (./setup.sh build)" >&2; exit 2; }
 command -v taskset > /dev/null || { echo "bench: taskset (util-linux) not found" >&2; exit 2; }
 mkdir -p "$OUT"
