@@ -6,8 +6,8 @@
 // prior's, not a measurement. Otherwise the estimate is the median of its free solves over the
 // second half of them, and its uncertainty their robust spread (1.4826 x MAD): the estimator's
 // value wanders with the window's excitation and the tracker's noise (on the seed-3 drives at a
-// 20 ms lag the last value was 1.2-4.2 ms off, the late half's median within 1.1 ms), so its last
-// value is one draw of that wander, not the drive's answer.
+// 20 ms lag the last value was 1.2-4.2 ms off, the late half's median 0.5-1.5 ms off), so its
+// last value is one draw of that wander, not the drive's answer.
 #include <string>
 #include <vector>
 
