@@ -24,39 +24,6 @@ nlohmann::json lonLat(const fusion::Utm& crs, double easting, double northing) {
   return {std::round(lla.lon_deg * 1e8) / 1e8, std::round(lla.lat_deg * 1e8) / 1e8};
 }
 
-// trajectory_lla.csv's lon/lat/h, a vertex per 2 m (the file is the run's own output; a line it
-// cannot parse is reported with its number).
-nlohmann::json track(const fs::path& csv) {
-  nlohmann::json coordinates = nlohmann::json::array();
-  std::ifstream in(csv);
-  std::string line;
-  Eigen::Vector3d last = Eigen::Vector3d::Constant(std::nan(""));
-  std::optional<fusion::EnuFrame> enu;  // at the first vertex: distances for the thinning
-  for (std::size_t number = 1; std::getline(in, line); ++number) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    std::string t, lat, lon, h;
-    std::getline(fields, t, ',');
-    std::getline(fields, lat, ',');
-    std::getline(fields, lon, ',');
-    std::getline(fields, h, ',');
-    fusion::Lla lla;
-    try {
-      lla = {std::stod(lat), std::stod(lon), std::stod(h)};
-    } catch (const std::exception&) {
-      throw io::InputError(csv, number, "expected t_s,lat_deg,lon_deg,h_ellipsoid_m,...");
-    }
-    if (!fusion::isValidLla(lla)) throw io::InputError(csv, number, "invalid lat/lon/h");
-    if (!enu) enu.emplace(lla);
-    const Eigen::Vector3d p = enu->toEnu(lla);
-    if (last.allFinite() && (p - last).norm() < 2.0) continue;
-    last = p;
-    coordinates.push_back({std::round(lla.lon_deg * 1e8) / 1e8, std::round(lla.lat_deg * 1e8) / 1e8,
-                           std::round(lla.h_ellipsoid_m * 1e3) / 1e3});
-  }
-  return coordinates;
-}
-
 std::string metadataYaml(const MergeFrame& frame, const MergeSummary& summary) {
   std::string text = fmt::format(
       "# Autoware divided point cloud map (pointcloud_map_loader): tile size and each PCD's\n"
@@ -101,13 +68,13 @@ nlohmann::json geojson(const std::vector<MergeRun>& runs, const MergeFrame& fram
                           {"point_source_ids", drives}}}});
   }
   for (const MergeRun& run : runs) {
-    const fs::path csv = run.dir / "trajectory_lla.csv";
-    if (!fs::exists(csv)) {
-      spdlog::warn("merge: {} has no trajectory_lla.csv: no track in tiles.geojson", run.name);
-      continue;
+    const auto it = summary.tracks.find(run.point_source_id);
+    if (it == summary.tracks.end() || it->second.size() < 2) continue;
+    nlohmann::json line = nlohmann::json::array();
+    for (const fusion::Lla& lla : it->second) {
+      line.push_back({std::round(lla.lon_deg * 1e8) / 1e8, std::round(lla.lat_deg * 1e8) / 1e8,
+                      std::round(lla.h_ellipsoid_m * 1e3) / 1e3});
     }
-    nlohmann::json line = track(csv);
-    if (line.size() < 2) continue;
     features.push_back(
         {{"type", "Feature"},
          {"geometry", {{"type", "LineString"}, {"coordinates", line}}},
@@ -118,6 +85,36 @@ nlohmann::json geojson(const std::vector<MergeRun>& runs, const MergeFrame& fram
 }
 
 }  // namespace
+
+std::vector<fusion::Lla> readTrack(const fs::path& csv) {
+  std::vector<fusion::Lla> vertices;
+  std::ifstream in(csv);
+  std::string line;
+  Eigen::Vector3d last = Eigen::Vector3d::Constant(std::nan(""));
+  std::optional<fusion::EnuFrame> enu;  // at the first vertex: distances for the thinning
+  for (std::size_t number = 1; std::getline(in, line); ++number) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    std::string t, lat, lon, h;
+    std::getline(fields, t, ',');
+    std::getline(fields, lat, ',');
+    std::getline(fields, lon, ',');
+    std::getline(fields, h, ',');
+    fusion::Lla lla;
+    try {
+      lla = {std::stod(lat), std::stod(lon), std::stod(h)};
+    } catch (const std::exception&) {
+      throw io::InputError(csv, number, "expected t_s,lat_deg,lon_deg,h_ellipsoid_m,...");
+    }
+    if (!fusion::isValidLla(lla)) throw io::InputError(csv, number, "invalid lat/lon/h");
+    if (!enu) enu.emplace(lla);
+    const Eigen::Vector3d p = enu->toEnu(lla);
+    if (last.allFinite() && (p - last).norm() < 2.0) continue;
+    last = p;
+    vertices.push_back(lla);
+  }
+  return vertices;
+}
 
 nlohmann::json tilesJson(const std::vector<MergeRun>& runs, const MergeFrame& frame,
                          const MergeSummary& summary) {

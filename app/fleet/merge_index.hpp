@@ -6,7 +6,7 @@
 //                                 y_min) in the map frame
 //   map_projector_info.yaml       Autoware's projector: LocalCartesianUTM at the map origin
 //   tiles.geojson                 RFC 7946: tile footprints (Polygon) and the drives' tracks
-//                                 (LineString, from trajectory_lla.csv)
+//                                 (LineString, from trajectory_lla.csv, carried as the map was)
 #include <filesystem>
 #include <map>
 #include <vector>
@@ -15,6 +15,7 @@
 
 #include "fleet/merge_inputs.hpp"
 #include "fleet/merge_tile.hpp"
+#include "fusion/geodesy.hpp"
 
 namespace gvio::fleet {
 
@@ -23,15 +24,21 @@ struct MergeSummary {
   std::vector<TileResult> tiles;
   std::map<std::uint16_t, std::uint64_t> points_per_drive;
   std::map<std::uint16_t, DriveAgreement> agreement;
+  // Per drive (point source ID): its track, a vertex per 2 m, where its map was placed (the joint
+  // alignment's correction applied as to its points); none for a run without trajectory_lla.csv.
+  std::map<std::uint16_t, std::vector<fusion::Lla>> tracks;
   std::uint64_t points = 0;
   double wall_s = 0.0, points_per_s = 0.0, peak_rss_mb = 0.0;
 };
 
+// A run's trajectory_lla.csv as lat/lon/h vertices, thinned to one per 2 m; a line it cannot
+// parse is an InputError naming it (the file is the run's own output).
+std::vector<fusion::Lla> readTrack(const std::filesystem::path& csv);
+
 nlohmann::json tilesJson(const std::vector<MergeRun>& runs, const MergeFrame& frame,
                          const MergeSummary& summary);
 
-// Writes the four index files atomically. Tracks come from each run's trajectory_lla.csv, thinned
-// to a vertex per 2 m; a run without one has no track (logged).
+// Writes the four index files atomically; the tracks are summary.tracks.
 void writeMergeIndex(const std::filesystem::path& out_dir, const std::vector<MergeRun>& runs,
                      const MergeFrame& frame, const MergeSummary& summary);
 

@@ -42,6 +42,21 @@ std::uint64_t spillRun(const MergeRun& run, const MergeFrame& frame, TileSpill& 
   return added;
 }
 
+// A run's track from its trajectory_lla.csv, carried onto the joint alignment's poses as its
+// points are (through the run's own ENU frame), so that the tracks lie on the merged map.
+std::vector<fusion::Lla> runTrack(const MergeRun& run, mapping::MapCorrection* correction) {
+  const fs::path csv = run.dir / "trajectory_lla.csv";
+  if (!fs::exists(csv)) {
+    spdlog::warn("merge: {} has no trajectory_lla.csv: no track in tiles.geojson", run.name);
+    return {};
+  }
+  std::vector<fusion::Lla> track = readTrack(csv);
+  if (correction == nullptr) return track;
+  const fusion::EnuFrame enu(run.georef.enu_origin);
+  for (fusion::Lla& lla : track) lla = enu.toLla(correction->apply(enu.toEnu(lla)));
+  return track;
+}
+
 void logAlignment(const std::vector<MergeRun>& runs, const MergeAlignment& a) {
   if (!a.attempted) return;
   spdlog::info(
@@ -132,6 +147,7 @@ MergeSummary runMerge(const MergeRequest& request) {
       correction = &*alignment.corrections[r];
     }
     const std::uint64_t n = spillRun(run, frame, spill, correction);
+    summary.tracks[run.point_source_id] = runTrack(run, correction);
     if (correction != nullptr) alignment.corrections[r].reset();  // its cell cache is done
     summary.points_per_drive[run.point_source_id] = n;
     summary.points += n;

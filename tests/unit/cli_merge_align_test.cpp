@@ -5,7 +5,15 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <optional>
+#include <vector>
 
 #include "io/run_dir.hpp"
 #include "support/fixtures.hpp"
@@ -14,6 +22,42 @@ namespace gvio::test {
 namespace {
 using testing::HasSubstr;
 namespace fs = std::filesystem;
+
+// Median horizontal distance (m) from drive 2's track vertices in tiles.geojson to drive 1's track
+// (the polyline), in a local tangent plane (metres per degree at the first vertex: ample over a
+// few hundred metres).
+double trackSeparationM(const fs::path& map) {
+  const nlohmann::json geo = io::readJsonObject(map / "tiles.geojson");
+  std::map<int, std::vector<Eigen::Vector2d>> tracks;
+  std::optional<Eigen::Vector2d> origin;
+  for (const auto& f : geo["features"]) {
+    if (f["properties"]["kind"] != "track") continue;
+    auto& line = tracks[f["properties"]["point_source_id"].get<int>()];
+    for (const auto& c : f["geometry"]["coordinates"]) {
+      const Eigen::Vector2d lon_lat(c[0].get<double>(), c[1].get<double>());
+      if (!origin) origin = lon_lat;
+      const double m_per_deg = 111319.5;
+      line.emplace_back(
+          (lon_lat.x() - origin->x()) * m_per_deg * std::cos(origin->y() * M_PI / 180),
+          (lon_lat.y() - origin->y()) * m_per_deg);
+    }
+  }
+  EXPECT_EQ(tracks.size(), 2U);
+  const auto& first = tracks[1];
+  std::vector<double> d;
+  for (const Eigen::Vector2d& p : tracks[2]) {
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k + 1 < first.size(); ++k) {
+      const Eigen::Vector2d a = first[k], ab = first[k + 1] - a;
+      const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
+      best = std::min(best, (a + t * ab - p).norm());
+    }
+    d.push_back(best);
+  }
+  if (d.empty()) return std::numeric_limits<double>::infinity();
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
 
 class CliMergeAlign : public ::testing::Test {
  protected:
@@ -83,6 +127,13 @@ TEST_F(CliMergeAlign, LoopsBetweenTheDrivesBringTheirMapsIntoAgreement) {
             << after["median_m"] << " m) aligned\n";
   EXPECT_GT(after["within_percent"].get<double>(), before["within_percent"].get<double>() + 10.0);
   EXPECT_LT(after["median_m"].get<double>(), 0.2);
+  // The tracks in tiles.geojson move with the maps: the same route's two tracks lie on each
+  // other once aligned (the map's agreement, centimetres), a receiver's error apart before.
+  const double track_apart_m = trackSeparationM(apart), track_joint_m = trackSeparationM(joint);
+  std::cout << "track separation (median): " << track_apart_m << " m apart, " << track_joint_m
+            << " m aligned\n";
+  EXPECT_LT(track_joint_m, 0.2);
+  EXPECT_LT(track_joint_m, 0.5 * track_apart_m);
   // Every point is still merged.
   EXPECT_EQ(io::readJsonObject(apart / "tiles.json")["points"],
             io::readJsonObject(joint / "tiles.json")["points"]);
