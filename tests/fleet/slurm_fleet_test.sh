@@ -8,95 +8,22 @@
 set -euo pipefail
 gvio=$1
 src=$2
-for tool in sbatch scancel sinfo slurmctld slurmd munged; do
-  if ! command -v "$tool" >/dev/null; then
-    echo "SKIP: $tool not found (Debian's slurm-wlm and munge; ./setup.sh test installs them)"
-    exit 77
-  fi
-done
-if [ "$(id -u)" -ne 0 ]; then
-  echo "SKIP: the test cluster's slurmd must run as root"
-  exit 77
-fi
-
+. "$src/tests/fleet/test_cluster.sh"
 work=$(mktemp -d /tmp/gvio_slurm_XXXXXX)
-pids=()
-stop_daemons() {
-  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
-  for pid in "${pids[@]}"; do
-    for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
-    kill -9 "$pid" 2>/dev/null || true
-  done
-  pids=()
-}
 cleanup() {
-  stop_daemons
+  test_cluster_stop
   rm -rf "$work"
 }
 trap cleanup EXIT
 fail() {
   echo "FAIL: $*"
-  for log in "$work"/cluster/log/*; do echo "--- $log"; tail -5 "$log"; done
+  test_cluster_logs "$work/cluster"
   exit 1
 }
 
 # --- the cluster
-c=$work/cluster
-mkdir -p "$c/munge" "$c/state" "$c/spool" "$c/log"
-chmod 700 "$c/munge"
-head -c 1024 /dev/urandom >"$c/munge/munge.key"
-chmod 600 "$c/munge/munge.key"
-munged --foreground --force --key-file="$c/munge/munge.key" --socket="$c/munge/munge.sock" \
-  --pid-file="$c/munge/munged.pid" --log-file="$c/log/munged.log" --seed-file="$c/munge/seed" \
-  >>"$c/log/munged.out" 2>&1 &
-pids+=($!)
-host=$(hostname -s)  # both daemons on the loopback: no DNS needed for the node's name
-port=$((20000 + RANDOM % 30000))
-memory_mb=$(($(awk '/MemTotal/ {print int($2 / 1024)}' /proc/meminfo) - 512))
-cat >"$c/slurm.conf" <<CONF
-ClusterName=gviotest
-SlurmctldHost=$host(127.0.0.1)
-SlurmUser=root
-SlurmdUser=root
-SlurmctldPort=$port
-SlurmdPort=$((port + 1))
-AuthType=auth/munge
-AuthInfo=socket=$c/munge/munge.sock
-CredType=cred/munge
-StateSaveLocation=$c/state
-SlurmdSpoolDir=$c/spool
-SlurmctldPidFile=$c/slurmctld.pid
-SlurmdPidFile=$c/slurmd.pid
-SlurmctldLogFile=$c/log/slurmctld.log
-SlurmdLogFile=$c/log/slurmd.log
-ProctrackType=proctrack/linuxproc
-TaskPlugin=task/none
-JobAcctGatherType=jobacct_gather/none
-AccountingStorageType=accounting_storage/none
-MpiDefault=none
-SwitchType=switch/none
-ReturnToService=2
-SchedulerType=sched/backfill
-SelectType=select/cons_tres
-SelectTypeParameters=CR_Core
-NodeName=$host NodeAddr=127.0.0.1 CPUs=$(nproc) RealMemory=$memory_mb State=UNKNOWN
-PartitionName=gvio Nodes=$host Default=YES MaxTime=INFINITE State=UP
-CONF
-echo "CgroupPlugin=cgroup/v1" >"$c/cgroup.conf"
-export SLURM_CONF=$c/slurm.conf
-sleep 1
-slurmctld -D -f "$SLURM_CONF" >>"$c/log/slurmctld.out" 2>&1 &
-ctld=$!
-pids+=("$ctld")
-slurmd -D -f "$SLURM_CONF" >>"$c/log/slurmd.out" 2>&1 &
-pids+=($!)
-for _ in $(seq 60); do
-  [ "$(sinfo -h -o %T 2>/dev/null)" = idle ] && break
-  sleep 0.5
-done
-[ "$(sinfo -h -o %T 2>/dev/null)" = idle ] || fail "the test cluster did not come up"
-started=("${pids[@]}")
-echo "cluster up: $host, port $port"
+test_cluster_start "$work/cluster" || exit $?
+started=("${test_cluster_pids[@]}")
 
 # --- three short drives (graph fusion at the simulator's origin) and one that does not exist
 geo="--set fusion.origin=48.98253,8.39035,116.4 --set fusion.lever_arm_b=[0,0,0.8]"
@@ -144,8 +71,8 @@ grep -q '"epsg": 32632' "$work/map/tiles.json" || fail "tiles.json: not UTM zone
 grep -q "x_resolution: 50" "$work/map/pointcloud_map_metadata.yaml" || fail "no Autoware index"
 
 # --- a controller that is gone: one line, exit 2
-kill "$ctld"
-for _ in $(seq 50); do kill -0 "$ctld" 2>/dev/null || break; sleep 0.1; done
+kill "$test_cluster_ctld"
+for _ in $(seq 50); do kill -0 "$test_cluster_ctld" 2>/dev/null || break; sleep 0.1; done
 echo "missing_drive" >"$work/one.txt"
 set +e
 "$gvio" fleet --drives "$work/one.txt" --out "$work/fleet2" --engine slurm 2>"$work/fleet2.err"
@@ -156,6 +83,6 @@ cat "$work/fleet2.err"
 grep -q "slurm engine: the job was not submitted: .*Unable to contact slurm controller" \
   "$work/fleet2.err" || fail "no one-line error for the unreachable controller"
 
-stop_daemons
+test_cluster_stop
 for pid in "${started[@]}"; do ! kill -0 "$pid" 2>/dev/null || fail "daemon $pid still running"; done
 echo "PASS: Slurm fleet of 3 drives (+1 missing), merged into $las tiles"

@@ -9,7 +9,10 @@ steers this with HTML comments, which the site does not show:
     <!-- tutorial: skip -->       the next sh block is not run (a download, a GUI, a long run)
     <!-- tutorial: run CMD -->    CMD runs here, unseen: it stands in for what the reader has
                                   and this machine does not (their own KITTI download, their
-                                  reference trajectory), never for a step the page shows
+                                  reference trajectory, their Slurm cluster), never for a step
+                                  the page shows; $GVIO_SOURCE is the repository. A CMD that
+                                  exits 77 skips the page (exit 77): what it stands in for
+                                  cannot be had here (no Slurm to start a cluster with)
 
 A page with no sh block, or whose directives are malformed, fails: a tutorial that silently ran
 nothing would pass forever.
@@ -82,12 +85,16 @@ def main():
     bin_dir = os.path.join(work, ".bin")
     os.makedirs(bin_dir)
     os.symlink(gvio, os.path.join(bin_dir, "gvio"))
-    env = dict(os.environ, PATH=bin_dir + os.pathsep + os.environ.get("PATH", ""))
+    env = dict(os.environ, PATH=bin_dir + os.pathsep + os.environ.get("PATH", ""),
+               GVIO_SOURCE=ROOT)
     full = "set -euo pipefail\nset -x\n" + script
     print(f"run_tutorial: {args.page}: {blocks} blocks in {work}", flush=True)
     rc = subprocess.run(["bash", "-c", full], cwd=work, env=env).returncode
     if not args.keep:
         shutil.rmtree(work, ignore_errors=True)
+    if rc == 77:
+        print(f"run_tutorial: {args.page}: skipped (a stand-in step cannot run here)")
+        sys.exit(77)
     if rc != 0:
         print(f"run_tutorial: {args.page}: a command failed (exit {rc}); the trace above "
               "shows which", file=sys.stderr)
