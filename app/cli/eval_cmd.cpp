@@ -34,6 +34,7 @@ struct EvalCliOptions {
   std::string align = "none", relation = "trans", rpe_unit = "frames", plot_plane = "auto";
   std::optional<double> rpe_delta;
   double t_max_diff_s = 0.01, t_offset_s = 0.0;
+  ConfigOptions config;  // its dataset.* keys read GNSS files as gvio run reads them
 };
 
 std::string alignmentName(eval::Alignment a) {
@@ -230,8 +231,10 @@ int runEval(const EvalCliOptions& o) {
     throw gvio::InvalidInput("--plot-plane: expected auto, xy, xz or yz");
   }
   const std::optional<eval::RevisitOptions> revisit_options = revisitOptions(o);
-  const eval::EvalInputs in = eval::loadEvalInputs({o.ref, o.ref_format, o.ref_times},
-                                                   {o.est, o.est_format, o.est_times}, o.origin);
+  const AppConfig config = o.config.load();
+  const eval::EvalInputs in =
+      eval::loadEvalInputs({o.ref, o.ref_format, o.ref_times}, {o.est, o.est_format, o.est_times},
+                           o.origin, config.dataset);
   if (in.enu_origin && opt.relation != eval::Relation::kTranslation) {
     throw gvio::InvalidInput("--relation " + o.relation +
                              ": a GNSS track has positions only; use --relation trans");
@@ -292,6 +295,12 @@ Command addEvalCommand(CLI::App& app) {
                   "lat,lon,h: the ENU origin of the local trajectory compared with a GNSS track "
                   "(a run's georef.json enu_origin); with two GNSS tracks, the frame's origin "
                   "(default: the reference's first position)");
+  sub->add_option("--config", o->config.file,
+                  "YAML configuration: its dataset.* keys read GNSS files as gvio run does");
+  sub->add_option("--set", o->config.overrides,
+                  "Override one config key: --set dataset.nmea_checksum=warn (repeatable)")
+      ->take_all()
+      ->allow_extra_args(false);
   sub->add_option("--ref-times", o->ref_times,
                   "Times file for a KITTI reference (seconds per line)");
   sub->add_option("--est-times", o->est_times, "Times file for a KITTI estimate");

@@ -61,6 +61,7 @@ int runSimulate(SimulateCliOptions& o, const CommonOptions& common) {
   r.stereo = o.camera == "stereo";
   r.gnss = sim::parseGnssNoise(o.gnss);
   if (o.gnss_errors_from) r.gnss_errors_from = *o.gnss_errors_from;
+  r.gnss_reader = config.dataset;
   for (const auto& text : o.outages) r.outages_s.push_back(parseOutage(text));
   std::optional<Progress> progress;  // created once the frame count is known
   const sim::SimSummary s =

@@ -36,12 +36,13 @@ Trajectory loadLocal(const EvalSideRequest& side) {
   return traj;
 }
 
-io::GeoTrack loadGeodetic(const EvalSideRequest& side, const char* option) {
+io::GeoTrack loadGeodetic(const EvalSideRequest& side, const char* option,
+                          const io::ReaderConfig& reader) {
   if (side.times) {
     throw InvalidInput(
         fmt::format("{}: a times file is for KITTI poses, not a GNSS track", option));
   }
-  io::GeoTrack track = io::readGeoTrack(side.file, io::ReaderConfig{});
+  io::GeoTrack track = io::readGeoTrack(side.file, reader);
   for (const std::string& w : track.warnings) spdlog::warn("{}", w);
   return track;
 }
@@ -49,10 +50,11 @@ io::GeoTrack loadGeodetic(const EvalSideRequest& side, const char* option) {
 }  // namespace
 
 EvalInputs loadEvalInputs(const EvalSideRequest& ref, const EvalSideRequest& est,
-                          const std::optional<std::string>& origin) {
+                          const std::optional<std::string>& origin,
+                          const io::ReaderConfig& reader) {
   EvalInputs in;
-  if (isGeodetic(ref)) in.ref.geo = loadGeodetic(ref, "--ref-times");
-  if (isGeodetic(est)) in.est.geo = loadGeodetic(est, "--est-times");
+  if (isGeodetic(ref)) in.ref.geo = loadGeodetic(ref, "--ref-times", reader);
+  if (isGeodetic(est)) in.est.geo = loadGeodetic(est, "--est-times", reader);
   if (!in.ref.geo) in.ref.trajectory = loadLocal(ref);
   if (!in.est.geo) in.est.trajectory = loadLocal(est);
   std::optional<fusion::Lla> given;

@@ -9,6 +9,7 @@
 
 #include "fusion/geodesy.hpp"
 #include "io/geo_track.hpp"
+#include "io/reader_config.hpp"
 #include "odometry/trajectory.hpp"
 
 namespace gvio::eval {
@@ -29,10 +30,12 @@ struct EvalInputs {
   std::optional<fusion::Lla> enu_origin;  // set when either side is geodetic
 };
 
-// `origin`: "lat,lon,h" of the local sides' ENU frame, or none. Throws InvalidInput / InputError
-// naming the file for bad input, and InvalidInput when a local side meets a geodetic one without
-// an origin.
+// `origin`: "lat,lon,h" of the local sides' ENU frame, or none. `reader`: how GNSS files are read
+// (dataset.*: NMEA checksums, UERE, ellipses), as gvio run reads them. Throws InvalidInput /
+// InputError naming the file for bad input, and InvalidInput when a local side meets a geodetic
+// one without an origin.
 EvalInputs loadEvalInputs(const EvalSideRequest& ref, const EvalSideRequest& est,
-                          const std::optional<std::string>& origin);
+                          const std::optional<std::string>& origin,
+                          const io::ReaderConfig& reader = {});
 
 }  // namespace gvio::eval

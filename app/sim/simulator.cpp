@@ -133,7 +133,7 @@ std::vector<GnssSimFix> driveGnss(const SimRequest& r, const Drive& drive,
   if (!r.gnss_errors_from) {
     return synthesizeGnss(T_w_b_at, traj.t0_ns(), t1, enu, options, mixSeed(r.seed, 2));
   }
-  const io::GnssFileData solution = io::readGnssFile(*r.gnss_errors_from, io::ReaderConfig{});
+  const io::GnssFileData solution = io::readGnssFile(*r.gnss_errors_from, r.gnss_reader);
   for (const std::string& w : solution.warnings) spdlog::warn("{}", w);
   std::vector<std::int64_t> ref_t;
   std::vector<Eigen::Vector3d> ref_p;

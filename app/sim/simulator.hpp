@@ -10,6 +10,7 @@
 
 #include "fusion/geodesy.hpp"
 #include "io/dataset.hpp"
+#include "io/reader_config.hpp"
 #include "sim/body_orientation.hpp"
 #include "sim/gnss_synth.hpp"
 #include "sim/imu_synth.hpp"
@@ -35,6 +36,7 @@ struct SimRequest {
   // trajectory are replayed instead of the `gnss` model (sim/gnss_replay.hpp); needs a reference
   // CSV as the trajectory.
   std::optional<std::filesystem::path> gnss_errors_from;
+  io::ReaderConfig gnss_reader;  // how gnss_errors_from is read (dataset.*, as gvio run reads it)
   std::vector<std::pair<double, double>> outages_s;  // seconds since the drive's start
   std::uint64_t seed = 1;
   // The street world's seed (buildings, furniture, textures); nullopt: derived from `seed`. Two

@@ -170,6 +170,76 @@ TEST_F(CliRealGnss, EvalReadsSolutionsAndReferencesAsPositionTracks) {
   EXPECT_THAT(bad_origin.err, HasSubstr("--origin '95,1,2': expected lat,lon,h"));
 }
 
+// ddmm.mmmmmmm,N,dddmm.mmmmmmm,E
+std::string nmeaLatLon(const fusion::Lla& lla) {
+  const auto dm = [](double deg, int width) {
+    const double a = std::abs(deg);
+    const int d = static_cast<int>(a);
+    return fmt::format("{:0{}d}{:010.7f}", d, width, (a - d) * 60.0);
+  };
+  return fmt::format("{},{},{},{}", dm(lla.lat_deg, 2), lla.lat_deg >= 0 ? 'N' : 'S',
+                     dm(lla.lon_deg, 3), lla.lon_deg >= 0 ? 'E' : 'W');
+}
+
+// The same receiver's fixes as a logger writes them in NMEA (GGA + RMC, every RMC with a wrong
+// checksum, as a real reference logger's) and in gvio's GNSS CSV: gvio eval reads both, the NMEA
+// log refused until told `--set dataset.nmea_checksum=warn`, as gvio run and gvio simulate are.
+TEST_F(CliRealGnss, EvalAndSimulateReadNmeaAndCsvSolutionsAsRunDoes) {
+  const fusion::EnuFrame enu(kOrigin);
+  std::string nmea, csv = "#timestamp [ns],lat_deg,lon_deg,height_m,sigma_h_m,sigma_v_m\n";
+  for (int i = 0; i <= 30; i += 5) {
+    if (i == 15) continue;  // the gap
+    const double t = 0.2 * i;
+    const fusion::Lla f = enu.toLla(Eigen::Vector3d(0.0, 10.0 * t, 0.0) + kError);
+    const std::int64_t utc = io::gpstToUtcNs(
+        io::gpsWeekTowToGpstUnixNs(kWeek, static_cast<std::int64_t>((kTow0 + t) * 1e9 + 0.5)));
+    const io::CivilDate d = io::civilFromDays(utc / (86400 * kS));
+    const std::int64_t tod = (utc % (86400 * kS)) / kS;
+    const std::string time = fmt::format("{:02}{:02}{:02}.00", tod / 3600, tod / 60 % 60, tod % 60);
+    std::string rmc =
+        io::withNmeaChecksum(fmt::format("GPRMC,{},A,{},0.0,0.0,{:02}{:02}{:02},,,A", time,
+                                         nmeaLatLon(f), d.day, d.month, d.year % 100));
+    rmc.back() = rmc.back() == '0' ? '1' : '0';
+    nmea += rmc + "\n";
+    nmea += io::withNmeaChecksum(fmt::format("GPGGA,{},{},1,09,1.0,{:.3f},M,0.000,M,,", time,
+                                             nmeaLatLon(f), f.h_ellipsoid_m)) +
+            "\n";
+    csv += fmt::format("{},{:.10f},{:.10f},{:.4f},2.0,4.0\n", utc, f.lat_deg, f.lon_deg,
+                       f.h_ellipsoid_m);
+  }
+  writeText(p("rover.nmea"), nmea);
+  writeText(p("rover.csv"), csv);
+  const std::string eval = "eval --ref " + quoted(p("reference.csv")) + " --est ";
+
+  const auto refused = runGvio(eval + quoted(p("rover.nmea")));
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_THAT(refused.err, HasSubstr("6 of 6 RMC sentences failed their checksum"));
+  EXPECT_THAT(refused.err, HasSubstr("dataset.nmea_checksum: warn"));
+  EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  for (const std::string& est : {std::string("rover.nmea"), std::string("rover.csv")}) {
+    const auto r = runGvio(eval + quoted(p(est)) + " --set dataset.nmea_checksum=warn --json " +
+                           quoted(p(est + ".json")));
+    ASSERT_EQ(r.exit_code, 0) << est << ": " << r.err;
+    const auto j = nlohmann::json::parse(readText(p(est + ".json")));
+    EXPECT_EQ(j["ape"]["n"].get<int>(), 6) << est;
+    EXPECT_NEAR(j["horizontal"]["rmse"].get<double>(), std::hypot(1.5, 0.5), 1e-3) << est;
+    EXPECT_NEAR(j["vertical"]["median"].get<double>(), 2.0, 1e-3) << est;
+  }
+
+  // gvio simulate --gnss-errors-from reads the solution as gvio run would, --set included.
+  const std::string sim = "simulate --trajectory " + quoted(p("reference.csv")) +
+                          " --gnss-errors-from " + quoted(p("rover.nmea")) +
+                          " --set 'sim.gnss_lever_arm_m=[0,0,0]' --camera mono --seconds 5.5 "
+                          "--no-progress --out ";
+  const auto sim_refused = runGvio(sim + quoted(p("sim_refused")));
+  EXPECT_EQ(sim_refused.exit_code, 2);
+  EXPECT_THAT(sim_refused.err, HasSubstr("RMC sentences failed their checksum"));
+  const auto sim_warned =
+      runGvio(sim + quoted(p("sim_warned")) + " --set dataset.nmea_checksum=warn");
+  ASSERT_EQ(sim_warned.exit_code, 0) << sim_warned.err;
+  EXPECT_THAT(sim_warned.out, HasSubstr(" 5 GNSS fixes"));
+}
+
 // The real Nagoya files (../shared/data/nagoya2023): the rover's single-point and 5 Hz RTK
 // solutions against the GNSS/INS reference give the figures data/README.md states (SPP median
 // 2.9 m, RMS 14.3 m, p95 27 m; RTK 1,799 epochs called fixed with a median of 0.07 m).
