@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -145,6 +146,33 @@ TEST(FaultInputs, FiveSecondImuGapIsBridgedOnVision) {
   EXPECT_THAT(r.err, HasSubstr("1 gap(s) in the IMU longer than vio.max_imu_gap_s"));
   // Measured 0.15 m (0.06 m without the gap): vision carries the 5 s.
   EXPECT_LT(report(c)["evaluation"]["ape_se3"]["rmse"].get<double>(), 0.5);
+}
+
+TEST(FaultInputs, ACameraBlindForMostOfTheDriveMakesThePartialRun) {
+  FaultCase c("blind_camera");
+  // The first 7 s of both cameras see a grey wall: no corner, so the VIO initialises at about
+  // 8 s of a 10 s drive. The run finishes (exit 0) and says it is partial, in report.json and
+  // in its summary line, instead of "complete".
+  const cv::Mat grey =
+      cv::imread(c.file("image_00/data/0000000000.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(grey.empty());
+  for (const char* cam : {"image_00", "image_01"}) {
+    for (int i = 0; i < 70; ++i) {
+      const fs::path image = c.file(fmt::format("{}/data/{:010d}.png", cam, i));
+      ASSERT_TRUE(cv::imwrite(image.string(), cv::Mat(grey.size(), grey.type(), cv::Scalar(128))));
+    }
+  }
+  const CommandResult r = c.run();
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(reportStatus(c.out()), "partial");
+  EXPECT_THAT(r.err, HasSubstr("partial: the trajectory covers "));
+  const nlohmann::json coverage = report(c)["coverage"];
+  std::cout << "coverage: " << coverage.dump() << "\n";
+  EXPECT_NEAR(coverage["input_s"].get<double>(), 10.0, 0.01);
+  EXPECT_LT(coverage["fraction"].get<double>(), 0.5);
+  EXPECT_GT(coverage["output_s"].get<double>(), 0.5);  // it did start, late
+  expectFiniteOutputs(c.out());
+  expectNoTemporaries(c.out());
 }
 
 TEST(FaultInputs, SingularCalibrationIsRefused) {
