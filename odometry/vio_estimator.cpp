@@ -347,6 +347,12 @@ FrameResult VioEstimator::processFrame(std::int64_t t_ns, const TrackedFrame& tr
   s.last_features = tracked.features;
   if (tracked.stats.exposure_gain != 1.0) ++s.counters.exposure_corrected_frames;
   if (tracked.stats.stereo_gain != 1.0) ++s.counters.stereo_gain_corrected_frames;
+  s.counters.tracked_features += tracked.stats.tracked;
+  s.counters.new_features += tracked.stats.new_features;
+  s.counters.rejected_forward_backward += tracked.stats.rejected_fb;
+  s.counters.rejected_ransac += tracked.stats.rejected_ransac;
+  s.counters.stereo_matches += tracked.stats.stereo_matches;
+  s.counters.rejected_stereo += tracked.stats.rejected_stereo;
   r.ms_tracking = ms_tracking;
   r.ms_estimator = msSince(start_estimator);
   if (!r.T_w_b.matrix().allFinite() || !r.v_w_mps.allFinite()) {

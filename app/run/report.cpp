@@ -111,6 +111,16 @@ json buildReport(const io::Dataset& ds, const VioRunResult& run, const ReportCon
                       {"frames_skipped_unreadable", run.frames_skipped_unreadable},
                       {"poses_written", run.trajectory.size()},
                       {"poses_nonfinite", run.nonfinite_poses}};
+  const auto per_frame = [&](std::int64_t sum) {
+    return c.frames > 0 ? static_cast<double>(sum) / c.frames : 0.0;
+  };
+  report["tracker"] = {
+      {"tracked_per_frame", per_frame(c.tracked_features)},
+      {"new_per_frame", per_frame(c.new_features)},
+      {"rejected_forward_backward_per_frame", per_frame(c.rejected_forward_backward)},
+      {"rejected_ransac_per_frame", per_frame(c.rejected_ransac)},
+      {"stereo_matches_per_frame", per_frame(c.stereo_matches)},
+      {"rejected_stereo_per_frame", per_frame(c.rejected_stereo)}};
   report["timing_ms"] = {{"image_load", timingJson(run.timings.load_ms)},
                          {"rectify", timingJson(run.timings.rectify_ms)},
                          {"tracking", timingJson(run.timings.tracking_ms)},

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "cli/config.hpp"
@@ -260,6 +261,19 @@ TEST_F(CliRunEndToEnd, ReportHasTheContractFields) {
   EXPECT_GE(r["counts"]["keyframes"].get<int>(), 1);
   EXPECT_GE(r["counts"]["initializations"].get<int>(), 1);
   EXPECT_EQ(r["counts"]["frames_skipped_unreadable"], 0);
+  // The front end's per-frame means: a textured street keeps well over a hundred tracks, most of
+  // them stereo-matched; what it rejects is a fraction of what it tracks.
+  const nlohmann::json& t = r["tracker"];
+  std::cout << "tracker: " << t.dump() << "\n";
+  EXPECT_GT(t["tracked_per_frame"].get<double>(), 100.0);
+  EXPECT_GT(t["stereo_matches_per_frame"].get<double>(),
+            0.5 * t["tracked_per_frame"].get<double>());
+  EXPECT_LE(t["stereo_matches_per_frame"].get<double>(),
+            t["tracked_per_frame"].get<double>() + t["new_per_frame"].get<double>());
+  EXPECT_LT(t["rejected_forward_backward_per_frame"].get<double>(),
+            0.5 * t["tracked_per_frame"].get<double>());
+  EXPECT_GE(t["rejected_ransac_per_frame"].get<double>(), 0.0);
+  EXPECT_GE(t["rejected_stereo_per_frame"].get<double>(), 0.0);
   for (const char* stage : {"tracking", "estimator", "total"}) {
     for (const char* stat : {"mean", "p95", "max"}) {
       EXPECT_TRUE(r["timing_ms"][stage][stat].is_number()) << stage << "." << stat;
