@@ -6,7 +6,9 @@
 # during the solve: the stage's wall time is what a user waits for). Prints each run's per-frame
 # tracking and estimator times (report.json timing_ms), the VIO stage's wall time per frame, the
 # VIO APE and whether the two trajectories are the same bytes, with the load average before each
-# run (the figures need an otherwise idle machine). A benchmark, not a test: nothing asserts.
+# run (the figures need an otherwise idle machine). BENCH_SET ("key=value ...") adds `--set`
+# overrides to both runs (an option's cost: BENCH_SET="vio.tracker.detect_level=1"). A benchmark,
+# not a test: nothing asserts.
 #
 #   tests/bench/vio_per_frame.sh [OUT]        # OUT defaults to out/bench/vio_per_frame
 set -euo pipefail
@@ -18,6 +20,7 @@ command -v taskset > /dev/null || { echo "bench: taskset (util-linux) not found"
 mkdir -p "$OUT"
 
 VIO_ONLY=(--gnss off --set map.enabled=false --set loops.enabled=false --no-progress)
+for kv in ${BENCH_SET:-}; do VIO_ONLY+=(--set "$kv"); done
 cut -d' ' -f1 /proc/loadavg > "$OUT/load_one_core.txt"
 taskset -c 0 "$GVIO" run --dataset "$CACHE" "${VIO_ONLY[@]}" --threads 1 --out "$OUT/one_core"
 cut -d' ' -f1 /proc/loadavg > "$OUT/load_two_threads.txt"
