@@ -87,12 +87,10 @@ ProgressStyle CommonOptions::progressStyle() const {
   return chooseProgressStyle(!no_progress && quiet == 0, stderr);
 }
 
-void ConfigOptions::addTo(CLI::App& sub) {
-  sub.add_option("--config", file, "YAML configuration (see assets/config/default.yaml)");
-  sub.add_option("--set", overrides,
-                 "Override one config key: --set dataset.gap_factor=3 (repeatable)")
-      ->take_all()
-      ->allow_extra_args(false);
+void ConfigOptions::addTo(CLI::App& sub, const std::string& config_help,
+                          const std::string& set_help) {
+  sub.add_option("--config", file, config_help);
+  sub.add_option("--set", overrides, set_help)->take_all()->allow_extra_args(false);
 }
 
 AppConfig ConfigOptions::load() const {

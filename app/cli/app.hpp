@@ -40,7 +40,11 @@ struct ConfigOptions {
   std::optional<std::string> file;
   std::vector<std::string> overrides;
 
-  void addTo(CLI::App& sub);
+  // --config and --set; a command that reads only some keys says which in the help texts.
+  void addTo(CLI::App& sub,
+             const std::string& config_help = "YAML configuration (see assets/config/default.yaml)",
+             const std::string& set_help =
+                 "Override one config key: --set dataset.gap_factor=3 (repeatable)");
   [[nodiscard]] AppConfig load() const;
 };
 

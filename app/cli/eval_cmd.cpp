@@ -295,12 +295,8 @@ Command addEvalCommand(CLI::App& app) {
                   "lat,lon,h: the ENU origin of the local trajectory compared with a GNSS track "
                   "(a run's georef.json enu_origin); with two GNSS tracks, the frame's origin "
                   "(default: the reference's first position)");
-  sub->add_option("--config", o->config.file,
-                  "YAML configuration: its dataset.* keys read GNSS files as gvio run does");
-  sub->add_option("--set", o->config.overrides,
-                  "Override one config key: --set dataset.nmea_checksum=warn (repeatable)")
-      ->take_all()
-      ->allow_extra_args(false);
+  o->config.addTo(*sub, "YAML configuration: its dataset.* keys read GNSS files as gvio run does",
+                  "Override one config key: --set dataset.nmea_checksum=warn (repeatable)");
   sub->add_option("--ref-times", o->ref_times,
                   "Times file for a KITTI reference (seconds per line)");
   sub->add_option("--est-times", o->est_times, "Times file for a KITTI estimate");

@@ -13,6 +13,7 @@
 #include "io/nmea.hpp"
 #include "io/text.hpp"
 #include "io/trajectory_io.hpp"
+#include "sim/gnss_synth.hpp"
 #include "support/fixtures.hpp"
 
 namespace gvio::test {
@@ -170,43 +171,40 @@ TEST_F(CliRealGnss, EvalReadsSolutionsAndReferencesAsPositionTracks) {
   EXPECT_THAT(bad_origin.err, HasSubstr("--origin '95,1,2': expected lat,lon,h"));
 }
 
-// ddmm.mmmmmmm,N,dddmm.mmmmmmm,E
-std::string nmeaLatLon(const fusion::Lla& lla) {
-  const auto dm = [](double deg, int width) {
-    const double a = std::abs(deg);
-    const int d = static_cast<int>(a);
-    return fmt::format("{:0{}d}{:010.7f}", d, width, (a - d) * 60.0);
-  };
-  return fmt::format("{},{},{},{}", dm(lla.lat_deg, 2), lla.lat_deg >= 0 ? 'N' : 'S',
-                     dm(lla.lon_deg, 3), lla.lon_deg >= 0 ? 'E' : 'W');
-}
-
-// The same receiver's fixes as a logger writes them in NMEA (GGA + RMC, every RMC with a wrong
-// checksum, as a real reference logger's) and in gvio's GNSS CSV: gvio eval reads both, the NMEA
-// log refused until told `--set dataset.nmea_checksum=warn`, as gvio run and gvio simulate are.
+// The same receiver's fixes as a logger writes them in NMEA (GGA + RMC + GST, every RMC with a
+// wrong checksum, as a real reference logger's) and in gvio's GNSS CSV, by the simulator's own
+// writers: gvio eval reads both, the NMEA log refused until told
+// `--set dataset.nmea_checksum=warn`, as gvio run and gvio simulate are.
 TEST_F(CliRealGnss, EvalAndSimulateReadNmeaAndCsvSolutionsAsRunDoes) {
   const fusion::EnuFrame enu(kOrigin);
-  std::string nmea, csv = "#timestamp [ns],lat_deg,lon_deg,height_m,sigma_h_m,sigma_v_m\n";
+  std::vector<GnssFix> fixes;
   for (int i = 0; i <= 30; i += 5) {
     if (i == 15) continue;  // the gap
     const double t = 0.2 * i;
     const fusion::Lla f = enu.toLla(Eigen::Vector3d(0.0, 10.0 * t, 0.0) + kError);
-    const std::int64_t utc = io::gpstToUtcNs(
+    GnssFix fix;
+    fix.t_ns = io::gpstToUtcNs(
         io::gpsWeekTowToGpstUnixNs(kWeek, static_cast<std::int64_t>((kTow0 + t) * 1e9 + 0.5)));
-    const io::CivilDate d = io::civilFromDays(utc / (86400 * kS));
-    const std::int64_t tod = (utc % (86400 * kS)) / kS;
-    const std::string time = fmt::format("{:02}{:02}{:02}.00", tod / 3600, tod / 60 % 60, tod % 60);
-    std::string rmc =
-        io::withNmeaChecksum(fmt::format("GPRMC,{},A,{},0.0,0.0,{:02}{:02}{:02},,,A", time,
-                                         nmeaLatLon(f), d.day, d.month, d.year % 100));
-    rmc.back() = rmc.back() == '0' ? '1' : '0';
-    nmea += rmc + "\n";
-    nmea += io::withNmeaChecksum(fmt::format("GPGGA,{},{},1,09,1.0,{:.3f},M,0.000,M,,", time,
-                                             nmeaLatLon(f), f.h_ellipsoid_m)) +
-            "\n";
-    csv += fmt::format("{},{:.10f},{:.10f},{:.4f},2.0,4.0\n", utc, f.lat_deg, f.lon_deg,
-                       f.h_ellipsoid_m);
+    fix.lat_deg = f.lat_deg;
+    fix.lon_deg = f.lon_deg;
+    fix.h_ellipsoid_m = f.h_ellipsoid_m;
+    fix.sigma_h_m = 2.0;
+    fix.sigma_v_m = 4.0;
+    fix.hdop = 1.0;
+    fix.num_sats = 9;
+    fixes.push_back(fix);
   }
+  const std::string log = sim::toNmeaLog(fixes);
+  std::string nmea;
+  for (std::string_view line : io::splitDelimited(log, '\n')) {
+    std::string sentence(line);
+    if (sentence.starts_with("$GPRMC")) {  // the checksum's last digit, before the "\r"
+      char& digit = sentence[sentence.find('*') + 2];
+      digit = digit == '0' ? '1' : '0';
+    }
+    if (!sentence.empty()) nmea += sentence + "\n";
+  }
+  const std::string csv = sim::toGnssCsv(fixes);
   writeText(p("rover.nmea"), nmea);
   writeText(p("rover.csv"), csv);
   const std::string eval = "eval --ref " + quoted(p("reference.csv")) + " --est ";
@@ -227,15 +225,15 @@ TEST_F(CliRealGnss, EvalAndSimulateReadNmeaAndCsvSolutionsAsRunDoes) {
   }
 
   // gvio simulate --gnss-errors-from reads the solution as gvio run would, --set included.
-  const std::string sim = "simulate --trajectory " + quoted(p("reference.csv")) +
-                          " --gnss-errors-from " + quoted(p("rover.nmea")) +
-                          " --set 'sim.gnss_lever_arm_m=[0,0,0]' --camera mono --seconds 5.5 "
-                          "--no-progress --out ";
-  const auto sim_refused = runGvio(sim + quoted(p("sim_refused")));
+  const std::string simulate = "simulate --trajectory " + quoted(p("reference.csv")) +
+                               " --gnss-errors-from " + quoted(p("rover.nmea")) +
+                               " --set 'sim.gnss_lever_arm_m=[0,0,0]' --camera mono --seconds 5.5 "
+                               "--no-progress --out ";
+  const auto sim_refused = runGvio(simulate + quoted(p("sim_refused")));
   EXPECT_EQ(sim_refused.exit_code, 2);
   EXPECT_THAT(sim_refused.err, HasSubstr("RMC sentences failed their checksum"));
   const auto sim_warned =
-      runGvio(sim + quoted(p("sim_warned")) + " --set dataset.nmea_checksum=warn");
+      runGvio(simulate + quoted(p("sim_warned")) + " --set dataset.nmea_checksum=warn");
   ASSERT_EQ(sim_warned.exit_code, 0) << sim_warned.err;
   EXPECT_THAT(sim_warned.out, HasSubstr(" 5 GNSS fixes"));
 }
