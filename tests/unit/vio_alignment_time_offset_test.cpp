@@ -2,6 +2,8 @@
 // whose visual poses belong to exposures t_d before the stamps the IMU is preintegrated between.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -119,9 +121,12 @@ TEST(ViAlignmentTimeOffset, RecoversALagOfTwentyMillisecondsWithTheBias) {
   EXPECT_NEAR(solved.t_d_s, 0.020, 1e-3);
   EXPECT_LT(solved.t_d_sigma_s, 2e-3);
   const double joint_error = (solved.gyr_bias - gyr_bias).norm();
-  EXPECT_LT(joint_error, 1e-3);  // 0.75 mrad/s: second-order terms of the 20 ms lag
-  // Without the offset the bias absorbs the lag (what the initialisation did before).
-  EXPECT_GT((solveGyroBias(w.frames) - gyr_bias).norm(), 3.0 * joint_error);  // 3.05 mrad/s
+  // Without the offset the bias absorbs the lag.
+  const double alone_error = (solveGyroBias(w.frames) - gyr_bias).norm();
+  std::printf("gyro bias error: %.2f mrad/s with the offset, %.2f mrad/s without\n",
+              1e3 * joint_error, 1e3 * alone_error);
+  EXPECT_LT(joint_error, 1e-3);  // second-order terms of the 20 ms lag
+  EXPECT_GT(alone_error, 3.0 * joint_error);
 }
 
 TEST(ViAlignmentTimeOffset, ASteadyTurnLeavesItAtThePrior) {
