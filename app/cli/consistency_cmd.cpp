@@ -129,7 +129,7 @@ int runConsistency(const ConsistencyOptions& o, ProgressStyle progress) {
   const auto s = mapping::cloudToSurface(surface, sparse, o.max_distance_m, kSparseMedianM);
   j["dense"] = fleet::surfaceStatsJson(d, kDenseMedianM);
   j["sparse"] = fleet::surfaceStatsJson(s, kSparseMedianM);
-  spdlog::info("dense points: {} , median {:.3f} m, p90 {:.3f} m to the reference (target <= {} m)",
+  spdlog::info("dense points: {}, median {:.3f} m, p90 {:.3f} m to the reference (target <= {} m)",
                d.n, d.median_m, d.p90_m, kDenseMedianM);
   spdlog::info("sparse landmarks: {}, median {:.3f} m, p90 {:.3f} m (target <= {} m)", s.n,
                s.median_m, s.p90_m, kSparseMedianM);

@@ -56,13 +56,15 @@ frames, loop_s = re.search(r"(\d+) frames in ([\d.]+) s", text).groups()
 wall, rss_kb = re.search(r"wall ([\d.]+) rss_kb (\d+)", text).groups()
 frames, loop_s, wall = int(frames), float(loop_s), float(wall)
 size = re.search(r"--size (\S+)", options)
-print(f"| {label}, {points} M map points | {view} {size.group(1) if size else '1280x720'}"
-      f" `{options}` | {frames} | {1e3 * loop_s / frames:.0f} | {wall - loop_s:.1f} |"
+size = size.group(1) if size else ("the camera's size" if view == "camera" else "1280x720")
+rest = re.sub(r"--size \S+ ?", "", options).strip()
+print(f"| {label}, {points} M map points | {view}, {size}{f' (`{rest}`)' if rest else ''}"
+      f" | {frames} | {1e3 * loop_s / frames:.0f} | {wall - loop_s:.1f} |"
       f" {int(rss_kb) / 1024:.0f} |")
 PY
 }
 
-echo "| map | view, size, options | frames | ms per frame (drawing, readback, encoding) | setup (s) | peak RSS (MiB) |"
+echo "| map | view, size (options) | frames | ms per frame (drawing, readback, encoding) | setup (s) | peak RSS (MiB) |"
 echo "| --- | --- | --- | --- | --- | --- |"
 demo=$(drive demo --trajectory assets/demo/drive.tum --seconds 20)
 video "demo drive 20 s" "$demo" follow --size 1920x1080

@@ -39,9 +39,7 @@ class CliRealGnss : public ::testing::Test {
         "GPS TOW (s),GPS Week,Latitude (deg),Longitude (deg),Ellipsoid Height (m),Roll "
         "(deg),Pitch (deg),Heading (deg),East Velocity (m/s),North Velocity (m/s),Up Velocity "
         "(m/s)\n";
-    std::string pos =
-        "%  GPST                  latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   "
-        "sde(m)   sdu(m)  sdne(m)  sdeu(m)  sdun(m) age(s)  ratio\n";
+    std::vector<GnssFix> fixes;
     for (int i = 0; i <= 30; ++i) {
       const double t = 0.2 * i;
       const fusion::Lla p = enu.toLla(Eigen::Vector3d(0.0, 10.0 * t, 0.0));
@@ -49,16 +47,18 @@ class CliRealGnss : public ::testing::Test {
                          kWeek, p.lat_deg, p.lon_deg, p.h_ellipsoid_m);
       if (i % 5 != 0 || i == 15) continue;
       const fusion::Lla f = enu.toLla(Eigen::Vector3d(0.0, 10.0 * t, 0.0) + kError);
-      const std::int64_t gpst =
-          io::gpsWeekTowToGpstUnixNs(kWeek, static_cast<std::int64_t>((kTow0 + t) * 1e9 + 0.5));
-      const io::CivilDate d = io::civilFromDays(gpst / (86400 * kS));
-      const std::int64_t tod = (gpst % (86400 * kS)) / kS;
-      pos += fmt::format(
-          "{}/{:02}/{:02} {:02}:{:02}:{:02}.000 {:14.9f} {:14.9f} {:10.4f}   5   9   2.0000   "
-          "2.0000   4.0000   0.0000   0.0000   0.0000   0.00    0.0\n",
-          d.year, d.month, d.day, tod / 3600, tod / 60 % 60, tod % 60, f.lat_deg, f.lon_deg,
-          f.h_ellipsoid_m);
+      GnssFix fix;  // a single-point solution: Q 5, 9 satellites, 2 m / 4 m sigmas
+      fix.t_ns = io::gpstToUtcNs(
+          io::gpsWeekTowToGpstUnixNs(kWeek, static_cast<std::int64_t>((kTow0 + t) * 1e9 + 0.5)));
+      fix.lat_deg = f.lat_deg;
+      fix.lon_deg = f.lon_deg;
+      fix.h_ellipsoid_m = f.h_ellipsoid_m;
+      fix.sigma_h_m = 2.0;
+      fix.sigma_v_m = 4.0;
+      fix.num_sats = 9;
+      fixes.push_back(fix);
     }
+    const std::string pos = sim::toRtklibPos(fixes);
     writeText(p("reference.csv"), csv);
     writeText(p("rover.pos"), pos);
   }
