@@ -286,6 +286,9 @@ TEST(GnssIns, NonHolonomicConstraintWithTheMountHelps) {
   EXPECT_LT(learned.rmse_3d, 0.75 * wrong.rmse_3d);
   EXPECT_FALSE(with.stats.mount.has_value());  // configured: used as it is
   ASSERT_TRUE(learned.stats.mount.has_value());
+  std::printf("estimated mount pitch %.2f deg off the true %.2f deg\n",
+              (learned.stats.mount->rpy_rad.y() - SimDrive().mount_rpy_rad.y()) * 180.0 / M_PI,
+              SimDrive().mount_rpy_rad.y() * 180.0 / M_PI);
   EXPECT_NEAR(learned.stats.mount->rpy_rad.y(), SimDrive().mount_rpy_rad.y(), 0.03);
   EXPECT_NEAR(learned.stats.mount->rpy_rad.z(), 0.0, 0.03);
 }
