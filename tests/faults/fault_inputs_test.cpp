@@ -5,6 +5,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -144,8 +146,10 @@ TEST(FaultInputs, FiveSecondImuGapIsBridgedOnVision) {
   const CommandResult r = c.run();
   expectCompleted(c, r);
   EXPECT_THAT(r.err, HasSubstr("1 gap(s) in the IMU longer than vio.max_imu_gap_s"));
-  // Measured 0.15 m (0.06 m without the gap): vision carries the 5 s.
-  EXPECT_LT(report(c)["evaluation"]["ape_se3"]["rmse"].get<double>(), 0.5);
+  // Vision carries the 5 s.
+  const double ape = report(c)["evaluation"]["ape_se3"]["rmse"].get<double>();
+  std::printf("5 s IMU gap: APE (SE3) %.3f m\n", ape);
+  EXPECT_LT(ape, 0.5);
 }
 
 TEST(FaultInputs, ACameraBlindForMostOfTheDriveMakesThePartialRun) {

@@ -6,6 +6,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <Eigen/Core>
 #include <cmath>
 #include <fstream>
@@ -108,9 +110,27 @@ TempDir* CliConsistencyImages::dir_ = nullptr;
 fs::path CliConsistencyImages::dataset_;
 
 // The truth is flagged nowhere (and every report file is there).
+// One line of a check's summary: the figures docs/cli/consistency.md's table gives.
+void printSummary(const char* what, const nlohmann::json& s) {
+  std::string stretches;
+  for (const auto& st : s["flagged_stretches"]) {
+    stretches +=
+        fmt::format(" {:.1f}-{:.1f} s", st["from_s"].get<double>(), st["to_s"].get<double>());
+  }
+  std::printf(
+      "%s: ZNCC mean %.3f, depth agreement mean %.3f, %d of %d flagged (%zu stretches:%s), %d not "
+      "enough evidence, %.0f ms per keyframe (median %.0f)\n",
+      what, s["ncc"]["mean"].get<double>(), s["depth_agreement"]["mean"].get<double>(),
+      s["keyframes"]["flagged"].get<int>(), s["keyframes"]["checked"].get<int>(),
+      s["flagged_stretches"].size(), stretches.c_str(),
+      s["keyframes"]["not_enough_evidence"].get<int>(), s["ms_per_keyframe"]["mean"].get<double>(),
+      s["ms_per_keyframe"]["median"].get<double>());
+}
+
 TEST_F(CliConsistencyImages, TheTruePosesAreFlaggedNowhere) {
   ASSERT_NO_FATAL_FAILURE(checkTruth());
   const nlohmann::json s = summary("truth");
+  printSummary("true poses", s);
   const std::size_t checked = s["keyframes"]["checked"].get<std::size_t>();
   EXPECT_GT(checked, 60U);  // 20 s at ~8 m/s, one map keyframe per 1.5 m
   const std::vector<CsvRow> rows = readRows(report("truth") / "keyframes.csv");
@@ -172,6 +192,7 @@ TEST_F(CliConsistencyImages, PosesMovedHalfAMetreAreFlaggedAtThatStretchOnly) {
   EXPECT_GT(compared, 0U);
   EXPECT_LT(summary("fault")["ncc"]["mean"].get<double>(),
             summary("truth")["ncc"]["mean"].get<double>());
+  printSummary("poses moved 0.5 m", summary("fault"));
 }
 
 TEST_F(CliConsistencyImages, TheVioPosesScoreBelowTheTruePoses) {

@@ -5,6 +5,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -100,7 +102,9 @@ TEST_F(CliRenderCamera, TheMapRepeatsTheImageFromTheRunsPoseAndNotFromADisplaced
   RecordProperty("ncc_own", std::to_string(ncc_own));
   RecordProperty("ncc_moved", std::to_string(ncc_moved));
   EXPECT_GT(covered, 0.3);
-  EXPECT_GT(ncc_own, 0.7) << ncc_moved;  // measured 0.785 and 0.517
+  std::printf("map over the image: NCC %.3f from the run's pose, %.3f moved 0.5 m sideways\n",
+              ncc_own, ncc_moved);
+  EXPECT_GT(ncc_own, 0.7) << ncc_moved;
   EXPECT_LT(ncc_moved, ncc_own - 0.15) << ncc_own;
 }
 
