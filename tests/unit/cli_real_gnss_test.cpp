@@ -28,6 +28,22 @@ const fusion::Lla kOrigin{35.1653, 136.8814, 41.0};
 // The receiver's error at every epoch (east, north, up).
 const Eigen::Vector3d kError(1.5, -0.5, 2.0);
 
+// The rover's single-point fix at t seconds after kTow0 on the drive north: Q 5 (single),
+// 9 satellites, 2 m / 4 m sigmas, the position off by kError.
+GnssFix roverFix(const fusion::EnuFrame& enu, double t) {
+  const fusion::Lla f = enu.toLla(Eigen::Vector3d(0.0, 10.0 * t, 0.0) + kError);
+  GnssFix fix;
+  fix.t_ns = io::gpstToUtcNs(
+      io::gpsWeekTowToGpstUnixNs(kWeek, static_cast<std::int64_t>((kTow0 + t) * 1e9 + 0.5)));
+  fix.lat_deg = f.lat_deg;
+  fix.lon_deg = f.lon_deg;
+  fix.h_ellipsoid_m = f.h_ellipsoid_m;
+  fix.sigma_h_m = 2.0;
+  fix.sigma_v_m = 4.0;
+  fix.num_sats = 9;
+  return fix;
+}
+
 // A car driving north at 10 m/s from kOrigin for 6 s, at 5 Hz: the reference CSV; and its RTKLIB
 // single-point solution at 1 Hz (GPST calendar), each epoch off by kError, the epoch at 3 s
 // missing (a gap).
@@ -46,17 +62,7 @@ class CliRealGnss : public ::testing::Test {
       csv += fmt::format("{:.1f},{},{:.10f},{:.10f},{:.4f},0.0,0.0,0.0,0.0,10.0,0.0\n", kTow0 + t,
                          kWeek, p.lat_deg, p.lon_deg, p.h_ellipsoid_m);
       if (i % 5 != 0 || i == 15) continue;
-      const fusion::Lla f = enu.toLla(Eigen::Vector3d(0.0, 10.0 * t, 0.0) + kError);
-      GnssFix fix;  // a single-point solution: Q 5, 9 satellites, 2 m / 4 m sigmas
-      fix.t_ns = io::gpstToUtcNs(
-          io::gpsWeekTowToGpstUnixNs(kWeek, static_cast<std::int64_t>((kTow0 + t) * 1e9 + 0.5)));
-      fix.lat_deg = f.lat_deg;
-      fix.lon_deg = f.lon_deg;
-      fix.h_ellipsoid_m = f.h_ellipsoid_m;
-      fix.sigma_h_m = 2.0;
-      fix.sigma_v_m = 4.0;
-      fix.num_sats = 9;
-      fixes.push_back(fix);
+      fixes.push_back(roverFix(enu, t));
     }
     const std::string pos = sim::toRtklibPos(fixes);
     writeText(p("reference.csv"), csv);
@@ -180,18 +186,8 @@ TEST_F(CliRealGnss, EvalAndSimulateReadNmeaAndCsvSolutionsAsRunDoes) {
   std::vector<GnssFix> fixes;
   for (int i = 0; i <= 30; i += 5) {
     if (i == 15) continue;  // the gap
-    const double t = 0.2 * i;
-    const fusion::Lla f = enu.toLla(Eigen::Vector3d(0.0, 10.0 * t, 0.0) + kError);
-    GnssFix fix;
-    fix.t_ns = io::gpstToUtcNs(
-        io::gpsWeekTowToGpstUnixNs(kWeek, static_cast<std::int64_t>((kTow0 + t) * 1e9 + 0.5)));
-    fix.lat_deg = f.lat_deg;
-    fix.lon_deg = f.lon_deg;
-    fix.h_ellipsoid_m = f.h_ellipsoid_m;
-    fix.sigma_h_m = 2.0;
-    fix.sigma_v_m = 4.0;
+    GnssFix fix = roverFix(enu, 0.2 * i);
     fix.hdop = 1.0;
-    fix.num_sats = 9;
     fixes.push_back(fix);
   }
   const std::string log = sim::toNmeaLog(fixes);
