@@ -19,7 +19,15 @@ OUT="${BENCH_OUT:-out/bench/render_video}"
 mkdir -p "$OUT" "$CACHE_ROOT"
 GEO=(--set "fusion.origin=48.98253,8.39035,116.4" --set "fusion.lever_arm_b=[0,0,0.8]")
 
-# drive NAME SIMULATE_ARGS...: simulates and runs (GNSS graph, map on) once; prints the run folder.
+# run_once SIM RUN: `gvio run` of SIM into RUN (GNSS graph, map on) unless RUN holds a complete run.
+run_once() {
+  if [ ! -f "$2/report.json" ] || ! grep -q '"status": "complete"' "$2/report.json"; then
+    rm -rf "$2"
+    "$GVIO" run --dataset "$1" --gnss graph "${GEO[@]}" --out "$2" --no-progress > /dev/null 2>&1
+  fi
+}
+
+# drive NAME SIMULATE_ARGS...: simulates and runs once; prints the run folder.
 drive() {
   local name="$1"
   shift
@@ -28,11 +36,7 @@ drive() {
     rm -rf "$sim"
     "$GVIO" simulate "$@" --out "$sim" --no-progress > /dev/null 2>&1
   fi
-  if [ ! -f "$run/report.json" ] || ! grep -q '"status": "complete"' "$run/report.json"; then
-    rm -rf "$run"
-    "$GVIO" run --dataset "$sim" --gnss graph "${GEO[@]}" --out "$run" --no-progress \
-      > /dev/null 2>&1
-  fi
+  run_once "$sim" "$run"
   echo "$run"
 }
 
@@ -80,11 +84,7 @@ fi
 full="$CACHE_ROOT/kitti00_full_seed1"
 if [ -f "$full/sim.yaml" ]; then
   run="$CACHE_ROOT/render_video_kitti00_full_run"
-  if [ ! -f "$run/report.json" ] || ! grep -q '"status": "complete"' "$run/report.json"; then
-    rm -rf "$run"
-    "$GVIO" run --dataset "$full" --gnss graph "${GEO[@]}" --out "$run" --no-progress \
-      > /dev/null 2>&1
-  fi
+  run_once "$full" "$run"
   video "KITTI-00" "$run" follow --size 1920x1080 --speed 50
   video "KITTI-00" "$run" topdown --size 1920x1080 --speed 50
 else
