@@ -155,9 +155,9 @@ TEST(Comma2k19Real, FusedPositionBeatsRawFixesByTwentyPercent) {
   RecordProperty("fused_3d_m", fmt::format("{:.3f}", fused_3d));
   RecordProperty("raw_3d_m", fmt::format("{:.3f}", raw_3d));
   // Measured (default config: time offset estimated online, no lever arm, non-holonomic
-  // constraint): horizontal 0.918 vs 1.474 m (-38 %), 3-D 1.430 vs 1.861 m (-23 %; the fixes'
-  // heights sit 1.07 m above the truth on average, which no filter removes). Without the
-  // constraint: 0.965 and 1.507 m (3-D -19 %).
+  // constraint, mount estimated): horizontal 0.957 vs 1.474 m (-35 %), 3-D 1.423 vs 1.861 m
+  // (-24 %; the fixes' heights sit 1.06 m above the truth on average, which no filter removes).
+  // Without the constraint (mount level): 0.965 and 1.507 m (3-D -19 %).
   EXPECT_NEAR(raw_h, 1.47, 0.02);
   EXPECT_LE(fused_h, 0.8 * raw_h) << "3-D: fused " << fused_3d << " raw " << raw_3d;
   EXPECT_LE(fused_3d, 0.8 * raw_3d) << "horizontal: fused " << fused_h << " raw " << raw_h;

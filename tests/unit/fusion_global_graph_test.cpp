@@ -106,7 +106,7 @@ LoopWorld makeLoopWorld() {
     if (k > 0) {
       Eigen::Isometry3d step = w.truth[k - 1].inverse() * w.truth[k];
       step.translation() *= 1.005;
-      step.translation() += 0.01 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+      step.translation() += 0.01 * Eigen::Vector3d{n01(rng), n01(rng), n01(rng)};
       step.linear() = step.linear() * Eigen::AngleAxisd(0.02 * std::numbers::pi / 180.0 * kStep,
                                                         Eigen::Vector3d::UnitZ())
                                           .toRotationMatrix();
@@ -124,7 +124,7 @@ LoopWorld makeLoopWorld() {
     loop.i = i;
     loop.j = j;
     loop.T_i_j = w.truth[i].inverse() * w.truth[j];
-    loop.T_i_j.translation() += 0.02 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+    loop.T_i_j.translation() += 0.02 * Eigen::Vector3d{n01(rng), n01(rng), n01(rng)};
     const double s_rot = 0.05 * std::numbers::pi / 180.0, s_pos = 0.02;
     loop.covariance.diagonal() << s_rot * s_rot, s_rot * s_rot, s_rot * s_rot, s_pos * s_pos,
         s_pos * s_pos, s_pos * s_pos;
@@ -208,7 +208,7 @@ TEST(GlobalGraph, FixesWithABiasAndLoopsMakeTheLapsAgree) {
     f.node = k;
     f.t_ns = w.nodes[k].t_ns;
     f.q_b = Eigen::Vector3d(0, 0, 0.8);
-    const Eigen::Vector3d err = bias + 1.5 * Eigen::Vector3d(n01(rng), n01(rng), 0.0);
+    const Eigen::Vector3d err = bias + 1.5 * Eigen::Vector3d{n01(rng), n01(rng), 0.0};
     f.p_enu = w.truth[k] * f.q_b + err;
     f.sigma_h_m = 1.5;
     f.sigma_v_m = 3.0;
@@ -273,7 +273,7 @@ TwoDrives makeTwoDrives(const LoopWorld& w) {
     f.node = k;
     f.t_ns = d.nodes[k].t_ns;
     f.p_enu = w.truth[k].translation() + bias[d.nodes[k].segment] +
-              0.3 * Eigen::Vector3d(n01(rng), n01(rng), 0.0);
+              0.3 * Eigen::Vector3d{n01(rng), n01(rng), 0.0};
     f.sigma_h_m = 1.5;
     f.sigma_v_m = 3.0;
     d.fixes.push_back(f);
@@ -363,7 +363,7 @@ TEST(GlobalGraph, EachFixQualityHasItsOwnBias) {
     f.node = static_cast<std::size_t>(k);
     f.t_ns = n.t_ns;
     f.p_enu = n.T_w_b.translation() + (fixed ? Eigen::Vector3d::Zero() : float_bias) +
-              (fixed ? 0.01 : 0.05) * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+              (fixed ? 0.01 : 0.05) * Eigen::Vector3d{n01(rng), n01(rng), n01(rng)};
     f.sigma_h_m = fixed ? 0.015 : 0.4;
     f.sigma_v_m = fixed ? 0.03 : 0.8;
     f.quality = fixed ? 4 : 5;

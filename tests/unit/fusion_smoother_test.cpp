@@ -174,7 +174,7 @@ TEST(GnssSmoother, EachFixQualityHasItsOwnBias) {
     f.T_w_b = T;  // an exact VIO in ENU
     f.T_enu_b = T;
     f.p_enu = T.translation() + (fixed ? Eigen::Vector3d::Zero() : float_bias) +
-              white * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+              white * Eigen::Vector3d{n01(rng), n01(rng), n01(rng)};
     f.sigma_h_m = fixed ? 0.015 : 0.4;
     f.sigma_v_m = fixed ? 0.03 : 0.8;
     f.quality = fixed ? 4 : 5;
