@@ -5,7 +5,8 @@
 # groundtruth.tum), `fused` (the run's trajectory.tum: graph fusion of SPP fixes + loops) and `vio`
 # (trajectory_vio.tum: the VIO alone, no loops, no GNSS). Each is a folder holding only the run's
 # report.json and config.yaml (the dataset and the map settings) and that trajectory, so the check
-# rebuilds the map from it. Prints one table. A benchmark, not a test: nothing asserts.
+# rebuilds the map from it. Prints one table (with the keyframes of not enough evidence, the
+# depth self-check and the revisits of summary.json). A benchmark, not a test: nothing asserts.
 #
 # BENCH_RUN: the run folder (default: the KITTI-00 graph+loops run of tests/bench/vio_kitti00.sh).
 # BENCH_SIM: instead of a run, a simulated dataset folder (e.g. vio_kitti00.sh's cache
@@ -16,6 +17,7 @@
 #   tests/bench/image_check_kitti00.sh
 #   BENCH_TRAJ=fused BENCH_ARGS="--every 5" tests/bench/image_check_kitti00.sh
 #   BENCH_SIM=build/bench_cache/kitti00_full_seed1 tests/bench/image_check_kitti00.sh
+#   BENCH_TABLE_ONLY=1 tests/bench/image_check_kitti00.sh   # the table of what BENCH_OUT holds
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 BUILD_DIR="${BUILD_DIR:-build}"
@@ -43,6 +45,7 @@ done
 for f in "${need[@]}"; do
   [ -f "$RUN/$f" ] || { echo "bench: $RUN has no $f (set BENCH_RUN or BENCH_SIM)" >&2; exit 2; }
 done
+if [ -z "${BENCH_TABLE_ONLY:-}" ]; then  # BENCH_TABLE_ONLY=1: the table of what BENCH_OUT holds
 rm -rf "$OUT"
 mkdir -p "$OUT"
 for t in $TRAJ; do
@@ -59,17 +62,33 @@ for t in $TRAJ; do
   /usr/bin/time -f "%e %M" -o "$OUT/$t.time" "$GVIO" --no-progress consistency --run "$OUT/$t" \
     --images ${BENCH_ARGS:-} > "$OUT/$t.log" 2>&1
 done
+fi
 python3 - "$OUT" $TRAJ <<'PY'
 import json, sys
 out, names = sys.argv[1], sys.argv[2:]
-print("| trajectory | keyframes | ZNCC mean | depth agreement mean | flagged (stretches) | ms per keyframe mean / median / p90 | wall s | peak RSS MiB |")
-print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+print("| trajectory | keyframes | ZNCC mean | depth agreement mean | flagged (stretches) | not enough evidence | self-check depth agreement | at revisits: keyframes, flagged, ZNCC of the other passes minus every source's (median) | ms per keyframe mean / median / p90 | wall s | peak RSS MiB |")
+print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+def num(v, fmt):
+    return "-" if v is None else format(v, fmt)
 for n in names:
     j = json.load(open(f"{out}/{n}/consistency_images/summary.json"))
     wall, rss_kb = open(f"{out}/{n}.time").read().split()
-    ms = j["ms_per_keyframe"]
+    ms, r = j["ms_per_keyframe"], j["revisits"]
     print(f"| {n} | {j['keyframes']['checked']} | {j['ncc']['mean']:.3f} | "
           f"{j['depth_agreement']['mean']:.3f} | {j['keyframes']['flagged']} "
-          f"({len(j['flagged_stretches'])}) | {ms['mean']:.0f} / {ms['median']:.0f} / "
-          f"{ms['p90']:.0f} | {float(wall):.0f} | {int(rss_kb) / 1024:.0f} |")
+          f"({len(j['flagged_stretches'])}) | {j['keyframes']['not_enough_evidence']} | "
+          f"{num(j['self_check']['depth_agreement_median'], '.3f')} | {r['keyframes']}, "
+          f"{r['flagged']}, {num(r['ncc']['median_minus_all_sources'], '+.3f')} | "
+          f"{ms['mean']:.0f} / {ms['median']:.0f} / {ms['p90']:.0f} | {float(wall):.0f} | "
+          f"{int(rss_kb) / 1024:.0f} |")
+for n in names:
+    j = json.load(open(f"{out}/{n}/consistency_images/summary.json"))
+    spans = ", ".join(f"{s['from_s']:.1f}" + (f"-{s['to_s']:.1f}" if s["to_s"] > s["from_s"] else "")
+                      for s in j["flagged_stretches"])
+    scores = {}
+    for f in j["flags"]:
+        key = f["reason"].split()[0]
+        scores[key] = scores.get(key, 0) + 1
+    print(f"\n{n}: flagged stretches (s from the start) {spans or 'none'}; flags by score: "
+          + (", ".join(f"{k} {v}" for k, v in sorted(scores.items())) or "none"))
 PY
