@@ -70,8 +70,8 @@ print("| trajectory | keyframes | ZNCC mean | depth agreement mean | flagged (st
 print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
 def num(v, fmt):
     return "-" if v is None else format(v, fmt)
-for n in names:
-    j = json.load(open(f"{out}/{n}/consistency_images/summary.json"))
+summaries = {n: json.load(open(f"{out}/{n}/consistency_images/summary.json")) for n in names}
+for n, j in summaries.items():
     wall, rss_kb = open(f"{out}/{n}.time").read().split()
     ms, r = j["ms_per_keyframe"], j["revisits"]
     print(f"| {n} | {j['keyframes']['checked']} | {j['ncc']['mean']:.3f} | "
@@ -81,8 +81,7 @@ for n in names:
           f"{r['flagged']}, {num(r['ncc']['median_minus_all_sources'], '+.3f')} | "
           f"{ms['mean']:.0f} / {ms['median']:.0f} / {ms['p90']:.0f} | {float(wall):.0f} | "
           f"{int(rss_kb) / 1024:.0f} |")
-for n in names:
-    j = json.load(open(f"{out}/{n}/consistency_images/summary.json"))
+for n, j in summaries.items():
     spans = ", ".join(f"{s['from_s']:.1f}" + (f"-{s['to_s']:.1f}" if s["to_s"] > s["from_s"] else "")
                       for s in j["flagged_stretches"])
     scores = {}

@@ -13,11 +13,13 @@ import os
 import re
 import sys
 
+from matrix_cells import cells
+
 EVENT = re.compile(r"vio ([0-9.]+) s: (initialized|waiting): visual-inertial alignment.*?"
                    r"(?:tilt|uncertain) \(?\+- ([0-9.]+) deg")
 
 
-def first_events(log):
+def alignment_events(log):
     """(t_s, kind, tilt_sigma_deg) of the alignment lines, in order."""
     with open(log) as f:
         return [(float(m.group(1)), m.group(2), float(m.group(3)))
@@ -35,21 +37,18 @@ def main():
     print("| cell | first alignment: tilt sigma (deg) | waited (s) | started with (deg) |")
     print("| --- | --- | --- | --- |")
     rows = 0
-    for out in args.outs:
-        for cell in sorted(os.listdir(out)):
-            log = os.path.join(out, cell, args.mode, "run.log")
-            if not re.fullmatch(r".+_seed\d+", cell) or not os.path.isfile(log):
-                continue
-            events = first_events(log)
-            if not events:
-                print(f"| {cell} | no alignment | | |")
-                continue
-            t0, _, sigma0 = events[0]
-            start = next((e for e in events if e[1] == "initialized"), None)
-            waited = f"{start[0] - t0:.1f}" if start and start[0] > t0 else "0"
-            started = f"{start[2]:.2f}" if start else "never"
-            print(f"| {cell} | {sigma0:.2f} | {waited} | {started} |")
-            rows += 1
+    for cell_dir, _, _, run in cells(args.outs, args.mode, needs="run.log"):
+        cell = os.path.basename(cell_dir)
+        events = alignment_events(os.path.join(run, "run.log"))
+        if not events:
+            print(f"| {cell} | no alignment | | |")
+            continue
+        t0, _, sigma0 = events[0]
+        start = next((e for e in events if e[1] == "initialized"), None)
+        waited = f"{start[0] - t0:.1f}" if start and start[0] > t0 else "0"
+        started = f"{start[2]:.2f}" if start else "never"
+        print(f"| {cell} | {sigma0:.2f} | {waited} | {started} |")
+        rows += 1
     if not rows:
         sys.exit("bench: no run.log in " + " ".join(args.outs))
 

@@ -12,12 +12,14 @@ BUILD_DIR (default build) gives the gvio binary; --mode picks the runs (default 
 --deltas the distances (default 10 100). A benchmark's table, not a test: nothing asserts."""
 import argparse
 import json
+import math
 import os
-import re
 import statistics
 import subprocess
 import sys
 import tempfile
+
+from matrix_cells import cells
 
 GVIO = os.path.join(os.environ.get("BUILD_DIR", "build"), "app", "gvio")
 
@@ -33,21 +35,14 @@ def rpe(run, delta, relation):
             return json.load(f)["rpe"]["rmse"]
 
 
-def cells(outs, mode):
-    for out in outs:
-        for cell in sorted(os.listdir(out)):
-            run = os.path.join(out, cell, mode)
-            if re.fullmatch(r".+_seed\d+", cell) and os.path.isfile(os.path.join(run, "trajectory_vio.tum")):
-                yield cell, run
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("outs", nargs="+", help="vio_matrix.sh BENCH_OUT folders")
     parser.add_argument("--mode", default="stereo-imu")
     parser.add_argument("--deltas", type=float, nargs="+", default=[10.0, 100.0])
     args = parser.parse_args()
-    runs = list(cells(args.outs, args.mode))
+    runs = [(os.path.basename(c), run)
+            for c, _, _, run in cells(args.outs, args.mode, needs="trajectory_vio.tum")]
     if not runs:
         sys.exit("bench: no run folders with a trajectory_vio.tum in " + " ".join(args.outs))
     head = " | ".join(f"{d:g} m: trans (m), rot (deg)" for d in args.deltas)
@@ -70,7 +65,7 @@ def main():
         mt, mr = statistics.median(t), statistics.median(r)
         print(f"{d:g} m over {len(t)} cells: median {mt:.3f} m ({min(t):.3f}-{max(t):.3f}) = "
               f"{100 * mt / d:.2f} % of the step, {mr:.3f} deg ({min(r):.3f}-{max(r):.3f}) = "
-              f"{mr * 3.141592653589793 / 180 / d:.2e} rad per metre")
+              f"{math.radians(mr) / d:.2e} rad per metre")
 
 
 if __name__ == "__main__":

@@ -17,6 +17,8 @@ import os
 import re
 import sys
 
+from matrix_cells import cells
+
 
 def load(path):
     try:
@@ -66,34 +68,30 @@ def main():
           "APE (m) | synchronised: estimated (ms) | synchronised APE (m) | APE change |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     within, within_last, within_2sigma, total = 0, 0, 0, 0
-    for out in args.outs:
-        for cell in sorted(os.listdir(out)):
-            m = re.fullmatch(r"(.+)_seed(\d+)", cell)
-            run = os.path.join(out, cell, args.mode)
-            if not m or not os.path.isdir(run):
-                continue
-            lag = lag_of(os.path.join(out, cell)) or 0.0
-            to = (load(os.path.join(run, "report.json")) or {}).get("time_offset", {})
-            total += 1
-            if to.get("status") == "estimated":
-                error = abs(to["t_d_s"] - lag)
-                within += error <= 0.001
-                within_2sigma += error <= 2.0 * to["sigma_s"]
-            if "t_d_final_s" in to:
-                within_last += abs(to["t_d_final_s"] - lag) <= 0.001
-            a = ape(run)
-            sync_run = os.path.join(args.sync, cell, args.mode) if args.sync else None
-            s = ape(sync_run) if sync_run else None
-            sync_to = ((load(os.path.join(sync_run, "report.json")) or {}).get("time_offset", {})
-                       if sync_run else None)
-            share = to.get("observed_fraction")
-            cells = [m.group(1), m.group(2), f"{1e3 * lag:.0f}", estimate(to), last_value(to),
-                     to.get("status", "?"), f"{share:.2f}" if share is not None else "",
-                     f"{a:.3f}" if a is not None else "failed",
-                     estimate(sync_to) if sync_to is not None else "",
-                     f"{s:.3f}" if s is not None else "",
-                     f"{100 * (a / s - 1):+.0f} %" if a and s else ""]
-            print("| " + " | ".join(cells) + " |")
+    for cell_dir, style, seed, run in cells(args.outs, args.mode):
+        lag = lag_of(cell_dir) or 0.0
+        to = (load(os.path.join(run, "report.json")) or {}).get("time_offset", {})
+        total += 1
+        if to.get("status") == "estimated":
+            error = abs(to["t_d_s"] - lag)
+            within += error <= 0.001
+            within_2sigma += error <= 2.0 * to["sigma_s"]
+        if "t_d_final_s" in to:
+            within_last += abs(to["t_d_final_s"] - lag) <= 0.001
+        a = ape(run)
+        cell = os.path.basename(cell_dir)
+        sync_run = os.path.join(args.sync, cell, args.mode) if args.sync else None
+        s = ape(sync_run) if sync_run else None
+        sync_to = ((load(os.path.join(sync_run, "report.json")) or {}).get("time_offset", {})
+                   if sync_run else None)
+        share = to.get("observed_fraction")
+        row = [style, seed, f"{1e3 * lag:.0f}", estimate(to), last_value(to),
+               to.get("status", "?"), f"{share:.2f}" if share is not None else "",
+               f"{a:.3f}" if a is not None else "failed",
+               estimate(sync_to) if sync_to is not None else "",
+               f"{s:.3f}" if s is not None else "",
+               f"{100 * (a / s - 1):+.0f} %" if a and s else ""]
+        print("| " + " | ".join(row) + " |")
     print()
     print(f"estimated within 1 ms of the lag: {within} of {total} cells (the last value: "
           f"{within_last} of {total}); within two of its own stated sigmas: {within_2sigma} of "
