@@ -5,7 +5,8 @@ of the first alignment over the 1 s window (the line `initialized: ...` or `wait
 deg)`), and, when the window waited for a better one, how much later it started and the tilt sigma
 it started with.
 
-    tests/bench/init_tilt_table.py out/bench/vio_matrix out/bench/vio_matrix_s2 out/bench/vio_matrix_s3
+    BENCH_MODES=stereo-imu tests/bench/vio_matrix.sh
+    tests/bench/init_tilt_table.py out/bench/vio_matrix
 
 --mode picks the runs (default stereo-imu). A benchmark's table, not a test: nothing asserts."""
 import argparse

@@ -6,7 +6,8 @@ run's trajectory_vio.tum against its groundtruth.tum, translation (m) and rotati
 angle_deg`), RMSE over the pairs D metres apart; then the median and range over the cells, and per
 step the fraction of D (translation) and radians per metre (rotation).
 
-    tests/bench/rpe_matrix.py out/bench/vio_matrix out/bench/vio_matrix_s2 out/bench/vio_matrix_s3
+    BENCH_MODES=stereo-imu tests/bench/vio_matrix.sh
+    tests/bench/rpe_matrix.py out/bench/vio_matrix
 
 BUILD_DIR (default build) gives the gvio binary; --mode picks the runs (default stereo-imu);
 --deltas the distances (default 10 100). A benchmark's table, not a test: nothing asserts."""
