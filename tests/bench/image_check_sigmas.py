@@ -6,7 +6,8 @@ consistency_images/keyframes.csv and prints: the keyframes scored, the lowest st
 depth-agreement residuals (`ncc_sigmas`, `depth_sigmas`: how many of their sigmas a keyframe lies
 from what is typical, negative below), the keyframes flagged (every one a false alarm) and how many
 of them drew their map nearer than NEAR_M (drawn_depth_m, 15 m: the views drawn as near), and the
-median residuals of the keyframes drawn that near. The figures behind the flag rule's items 3 and 7
+median residuals of the keyframes drawn that near, and the run's self-check (summary.json
+`self_check`: the median depth agreement of keyframes drawn from their own points). The figures behind the flag rule's items 3 and 7
 in docs/benchmarks/image-check.md; item 7 is measured without the rule's own correction too:
 
     BENCH_SEEDS="1 2" BENCH_FAULTS=side:0.5 tests/bench/image_check_matrix.sh
@@ -16,6 +17,7 @@ in docs/benchmarks/image-check.md; item 7 is measured without the rule's own cor
     tests/bench/image_check_sigmas.py out/bench/image_check_sv0
 """
 import csv
+import json
 import math
 import os
 import statistics
@@ -46,6 +48,17 @@ def cell_rows(cell):
         return list(csv.DictReader(f))
 
 
+def self_check(cell):
+    """The run's self-check: the median depth agreement of keyframes drawn from their own points."""
+    path = os.path.join(cell, "truth", "consistency_images", "summary.json")
+    try:
+        with open(path) as f:
+            value = json.load(f)["self_check"]["depth_agreement_median"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return ""
+    return f"{value:.3f}"
+
+
 def shown(value, digits=2):
     return "" if value is None else f"{value:+.{digits}f}"
 
@@ -67,13 +80,19 @@ def near_median(rows, key):
     return shown(statistics.median(values)), len(values)
 
 
+def at(flagged):
+    times = [float(r["t_from_start_s"]) for r in flagged]
+    return ", " + " ".join(f"{t:.1f}" for t in times) if times else ""
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "out/bench/image_check_matrix"
     if not os.path.isdir(out):
         sys.exit(f"bench: {out}: no such folder (run tests/bench/image_check_matrix.sh)")
     head = ["cell", "keyframes", "lowest ZNCC sigmas", "lowest depth sigmas",
-            f"flagged: all / drawn nearer than {NEAR_M:g} m",
-            f"drawn nearer than {NEAR_M:g} m: keyframes, median ZNCC / depth sigmas"]
+            f"flagged: all / drawn nearer than {NEAR_M:g} m, at (s)",
+            f"drawn nearer than {NEAR_M:g} m: keyframes, median ZNCC / depth sigmas",
+            "self-check depth agreement"]
     print("The image check's standardised residuals with the true poses (keyframes.csv "
           "ncc_sigmas, depth_sigmas)")
     print()
@@ -89,8 +108,9 @@ def main():
         ncc_near, n_near = near_median(rows, "ncc_sigmas")
         depth_near, _ = near_median(rows, "depth_sigmas")
         print(f"| {name} | {len(rows)} | {lowest(rows, 'ncc_sigmas')} | "
-              f"{lowest(rows, 'depth_sigmas')} | {len(flagged)} / {sum(map(near, flagged))} | "
-              f"{n_near}, {ncc_near} / {depth_near} |")
+              f"{lowest(rows, 'depth_sigmas')} | {len(flagged)} / {sum(map(near, flagged))}"
+              f"{at(flagged)} | "
+              f"{n_near}, {ncc_near} / {depth_near} | {self_check(os.path.join(out, name))} |")
     if not cells:
         sys.exit(f"bench: {out}: no cell with a truth run")
 
