@@ -24,7 +24,7 @@ std::pair<Trajectory, Trajectory> makePair(std::size_t n) {
     ref.poses.push_back(T);
     ref.t_ns.push_back(static_cast<std::int64_t>(i) * 10'000'000);
     Eigen::Isometry3d P = T;
-    P.translation() += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    P.translation() += Eigen::Vector3d{noise(rng), noise(rng), noise(rng)};
     est.poses.push_back(P);
     est.t_ns.push_back(static_cast<std::int64_t>(i) * 10'000'000 + 1'000'000);  // 1 ms offset
   }

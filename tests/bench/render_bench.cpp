@@ -34,7 +34,7 @@ Scene randomCloud(int n) {
   pc.points.reserve(static_cast<std::size_t>(n));
   pc.colors.reserve(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
-    pc.points.emplace_back(u(rng), u(rng), h(rng));
+    pc.points.push_back(Eigen::Vector3d{u(rng), u(rng), h(rng)});
     pc.colors.emplace_back(static_cast<float>(i % 255) / 255.0F, 0.5F, 0.5F, 1.0F);
   }
   pc.sizes_px = {2.0F};

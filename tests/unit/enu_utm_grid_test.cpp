@@ -19,7 +19,7 @@ TEST(EnuToUtmGrid, MatchesTheExactConversionWithinAMillimetreOverTenKilometres) 
   std::uniform_real_distribution<double> horizontal(-5000.0, 5000.0), up(-80.0, 120.0);
   double worst = 0.0;
   for (int k = 0; k < 20000; ++k) {
-    const Eigen::Vector3d p(horizontal(rng), horizontal(rng), up(rng));
+    const Eigen::Vector3d p{horizontal(rng), horizontal(rng), up(rng)};
     worst = std::max(worst, (grid.toUtm(p) - grid.exactUtm(p)).norm());
   }
   EXPECT_LT(worst, 1e-3);

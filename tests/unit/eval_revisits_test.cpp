@@ -141,7 +141,7 @@ std::pair<std::vector<Eigen::Vector3d>, std::vector<std::int64_t>> randomWalk(st
   std::vector<Eigen::Vector3d> p = {Eigen::Vector3d::Zero()};
   std::vector<std::int64_t> t = {0};
   while (p.size() < n) {
-    Eigen::Vector3d next = p.back() + Eigen::Vector3d(step(rng), step(rng), 0.1 * step(rng));
+    Eigen::Vector3d next = p.back() + Eigen::Vector3d{step(rng), step(rng), 0.1 * step(rng)};
     next = next.cwiseMax(Eigen::Vector3d(-10, -10, -1)).cwiseMin(Eigen::Vector3d(10, 10, 1));
     p.push_back(next);
     t.push_back(t.back() + dt_ns(rng));

@@ -49,7 +49,7 @@ TEST(GnssScreening, SkipsAndCountsEveryKindOfBadFix) {
 std::vector<Eigen::Vector3d> randomPath(std::mt19937& rng, int n) {
   std::uniform_real_distribution<double> u(-200.0, 200.0);
   std::vector<Eigen::Vector3d> p;
-  for (int k = 0; k < n; ++k) p.emplace_back(u(rng), u(rng), 0.05 * u(rng));
+  for (int k = 0; k < n; ++k) p.push_back(Eigen::Vector3d{u(rng), u(rng), 0.05 * u(rng)});
   return p;
 }
 
@@ -94,7 +94,7 @@ TEST(VioEnuAlignment, StraightPathFallsBackToYawWithoutAnImu) {
   for (int k = 0; k < 6; ++k) {
     p_w.emplace_back(8.0 * k, 0.0, 0.0);
     p_enu.push_back(Eigen::Vector3d(0.0, 8.0 * k, 0.0) +
-                    Eigen::Vector3d(noise(rng), noise(rng), 2.0 * noise(rng)));
+                    Eigen::Vector3d{noise(rng), noise(rng), 2.0 * noise(rng)});
   }
   EXPECT_LT(crossExtent(p_w), 1e-9);
   const auto unconstrained = alignVioToEnu(p_w, p_enu, AlignmentDof::kRotationTranslation);

@@ -22,7 +22,7 @@ std::vector<Eigen::Vector3d> axes(int count) {
   std::normal_distribution<double> normal;
   std::vector<Eigen::Vector3d> result;
   for (int i = 0; i < count; ++i) {
-    result.emplace_back(Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized());
+    result.emplace_back(Eigen::Vector3d{normal(rng), normal(rng), normal(rng)}.normalized());
   }
   return result;
 }
@@ -64,7 +64,7 @@ TEST(LieSo3, ExpOfLogIsIdentityIncludingNearZeroAndPi) {
   std::normal_distribution<double> normal;
   for (int i = 0; i < 200; ++i) {
     const Eigen::Quaterniond q =
-        Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
+        Eigen::Quaterniond{normal(rng), normal(rng), normal(rng), normal(rng)}.normalized();
     const Eigen::Matrix3d R = q.toRotationMatrix();
     EXPECT_LT((expSo3(logSo3(R)) - R).norm(), 1e-13);
   }

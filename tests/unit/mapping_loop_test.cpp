@@ -51,7 +51,7 @@ SyntheticPair makePair(int n, int outliers, std::uint64_t seed) {
   s.T_q_c.translation() = Eigen::Vector3d(0.4, -0.05, -1.2);
   cv::Mat cand_desc(0, 32, CV_8U), query_desc(0, 32, CV_8U);
   while (static_cast<int>(s.candidate.points) < n) {
-    const Eigen::Vector3d p(u01(rng) * 24.0 - 12.0, u01(rng) * 6.0 - 4.0, 5.0 + 20.0 * u01(rng));
+    const Eigen::Vector3d p{u01(rng) * 24.0 - 12.0, u01(rng) * 6.0 - 4.0, 5.0 + 20.0 * u01(rng)};
     const Eigen::Vector3d q = s.T_q_c * p;
     const Eigen::Vector2d px(cam.fx * q.x() / q.z() + cam.cx, cam.fy * q.y() / q.z() + cam.cy);
     if (q.z() < 1.0 || px.x() < 0 || px.y() < 0 || px.x() > 1240 || px.y() > 375) continue;

@@ -32,10 +32,10 @@ mapping::PlaceDatabase makeDatabase() {
     mapping::LoopKeyframe kf;
     kf.t_ns = 1'000'000'000LL * (k + 1);
     const int n = 5 + k;
-    for (int i = 0; i < n; ++i) kf.px.emplace_back(u(rng) + 100.0F, u(rng) + 50.0F);
+    for (int i = 0; i < n; ++i) kf.px.push_back(Eigen::Vector2f{u(rng) + 100.0F, u(rng) + 50.0F});
     kf.descriptors.create(n, 32, CV_8U);
     for (int i = 0; i < n * 32; ++i) kf.descriptors.data[i] = static_cast<std::uint8_t>(rng());
-    for (int i = 0; i < 3; ++i) kf.p_c.emplace_back(u(rng), u(rng), 10.0F + u(rng));
+    for (int i = 0; i < 3; ++i) kf.p_c.push_back(Eigen::Vector3f{u(rng), u(rng), 10.0F + u(rng)});
     kf.points = kf.p_c.size();
     if (k != 1) {
       kf.thumbnail.resize(mapping::kThumbnailWidth * mapping::kThumbnailHeight);

@@ -70,7 +70,7 @@ TEST_F(RenderTest, PinholeMathMatchesOpenCv) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int i = 0; i < 200; ++i)
-    pts.push_back(T_w_c * Eigen::Vector3d(8 * u(rng), 2 * u(rng), 20 + 15 * u(rng)));
+    pts.push_back(T_w_c * Eigen::Vector3d{8 * u(rng), 2 * u(rng), 20 + 15 * u(rng)});
   const auto cv_px = opencvProject(pts, K, T_w_c);
   for (std::size_t i = 0; i < pts.size(); ++i) {
     const Eigen::Vector2d px = projectToPixel(cam, pts[i]);

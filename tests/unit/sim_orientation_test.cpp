@@ -157,7 +157,7 @@ Trajectory stopAndGo() {
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();  // a file orientation that is ignored
     T.translation() =
         Eigen::Vector3d(s_m * std::cos(kHeadingRad), s_m * std::sin(kHeadingRad), 0.0) +
-        Eigen::Vector3d(jitter_m(rng), jitter_m(rng), jitter_m(rng));
+        Eigen::Vector3d{jitter_m(rng), jitter_m(rng), jitter_m(rng)};
     traj.t_ns.push_back(std::llround(t_s * 1e9));
     traj.poses.push_back(T);
   }
@@ -203,7 +203,7 @@ TEST(SimOrientation, APathThatNeverMovesHasNoHeading) {
   std::mt19937 rng(7);
   std::normal_distribution<double> jitter_m(0.0, 0.003);
   for (auto& T : still.poses) {
-    T.translation() = Eigen::Vector3d(jitter_m(rng), jitter_m(rng), jitter_m(rng));
+    T.translation() = Eigen::Vector3d{jitter_m(rng), jitter_m(rng), jitter_m(rng)};
   }
   EXPECT_THROW((void)orientationFromMotion(still, {}), InvalidInput);
 }

@@ -134,7 +134,7 @@ TEST(ViAlignment, TiltSigmaMatchesTheSpreadOfTheGravityDirection) {
     for (int trial = 0; trial < trials; ++trial) {
       Truth truth = makeTruth(Eigen::Vector3d::Zero(), R_v_w);
       for (AlignmentFrame& f : truth.frames) {
-        f.p_v_b += noise_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+        f.p_v_b += noise_m * Eigen::Vector3d{normal(rng), normal(rng), normal(rng)};
       }
       const auto result = alignVisualInertial(truth.frames, false, 0.5);
       ASSERT_TRUE(result.has_value()) << "noise " << noise_m << " trial " << trial;

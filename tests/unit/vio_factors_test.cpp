@@ -26,8 +26,8 @@ using test::numericTangentJacobian;
 std::array<double, 7> randomPose(std::mt19937& rng, double spread_m) {
   std::normal_distribution<double> n(0.0, 1.0);
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = expSo3(Eigen::Vector3d(n(rng), n(rng), n(rng)) * 0.5);
-  T.translation() = Eigen::Vector3d(n(rng), n(rng), n(rng)) * spread_m;
+  T.linear() = expSo3(Eigen::Vector3d{n(rng), n(rng), n(rng)} * 0.5);
+  T.translation() = Eigen::Vector3d{n(rng), n(rng), n(rng)} * spread_m;
   std::array<double, 7> x{};
   poseToBlock(T, x.data());
   return x;

@@ -31,7 +31,7 @@ Scene makeScene(int frames, int points, const Eigen::Vector3d& step, double yaw_
     s.T_w_c.push_back(T);
   }
   for (int i = 0; i < points; ++i) {
-    s.points_w.emplace_back(ux(rng), uy(rng), uz(rng));
+    s.points_w.push_back(Eigen::Vector3d{ux(rng), uy(rng), uz(rng)});
     SfmTrack t;
     t.id = static_cast<std::uint64_t>(100 + i);
     for (int k = 0; k < frames; ++k) {
