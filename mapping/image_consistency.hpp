@@ -59,9 +59,10 @@ struct ImageConsistencyConfig {
   // What is typical also depends on how near the drawn map is: a near surface is magnified (one
   // 0.1 m voxel spans 8 px at 9 m on KITTI, 3.6 px at 20 m) and was measured by the sources from
   // other directions, so a correct map reproduces it less well. With true poses on the seed-2
-  // KITTI-00 window (tests/bench/image_check_matrix.sh), the keyframes whose drawn map points lay
-  // at a median under 15 m (slow sharp turns at junctions, facing a wall: 21 of 259) scored a
-  // median 1.5-2 of their sigmas below their neighbours in time, the others 0. So a view's residual
+  // KITTI-00 window and similar_views 0 (tests/bench/image_check_sigmas.py), the keyframes whose
+  // drawn map points lay at a median under 15 m (slow sharp turns at junctions, facing a wall: 18
+  // of 259 on sparse texture) scored a median 3.0 ZNCC sigmas below their neighbours in time
+  // (1.3 on vegetation), and every false flag was among them. So a view's residual
   // s - m is judged against the median and the spread of the residuals of the similar_views views
   // whose drawn depth (ViewScore::drawn_depth_m) is nearest its own (in 1 / depth, the
   // magnification), among the views more than local_window_s away in time (a faulty stretch's
