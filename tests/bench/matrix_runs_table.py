@@ -73,7 +73,8 @@ for arg in args.runs:
     geo_m = geometric_mean([m for m, _ in ok])
     geo = geometric_mean([pct for _, pct in ok])
     within = sum(1 for _, pct in ok if pct <= TARGET)
-    met = re.search(r"^stereo-imu: (\d+) of (\d+) cells meet", text, re.M)
+    # "cells meet" in outputs before 6544b45, "cells within" since.
+    met = re.search(r"^stereo-imu: (\d+) of (\d+) cells (?:meet|within)", text, re.M)
     if met and int(met.group(2)) == len(values):
         within = int(met.group(1))
     mean = re.search(r"^stereo-imu: geometric mean APE ([0-9.]+) %", text, re.M)
