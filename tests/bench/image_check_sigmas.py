@@ -7,8 +7,9 @@ depth-agreement residuals (`ncc_sigmas`, `depth_sigmas`: how many of their sigma
 from what is typical, negative below), the keyframes flagged (every one a false alarm) and how many
 of them drew their map nearer than NEAR_M (drawn_depth_m, 15 m: the views drawn as near), and the
 median residuals of the keyframes drawn that near, and the run's self-check (summary.json
-`self_check`: the median depth agreement of keyframes drawn from their own points). The figures behind the flag rule's items 3 and 7
-in docs/benchmarks/image-check.md; item 7 is measured without the rule's own correction too:
+`self_check`: the median depth agreement of keyframes drawn from their own points). The figures
+behind the flag rule's items 3 and 7 in docs/benchmarks/image-check.md; item 7 is measured
+without the rule's own correction too:
 
     BENCH_SEEDS="1 2" BENCH_FAULTS=side:0.5 tests/bench/image_check_matrix.sh
     tests/bench/image_check_sigmas.py out/bench/image_check_matrix
@@ -40,8 +41,13 @@ def near(row):
     return depth is not None and depth < NEAR_M
 
 
+def check_file(cell, name):
+    """A file of the cell's check along its true poses."""
+    return os.path.join(cell, "truth", "consistency_images", name)
+
+
 def cell_rows(cell):
-    path = os.path.join(cell, "truth", "consistency_images", "keyframes.csv")
+    path = check_file(cell, "keyframes.csv")
     if not os.path.exists(path):
         return None
     with open(path) as f:
@@ -50,7 +56,7 @@ def cell_rows(cell):
 
 def self_check(cell):
     """The run's self-check: the median depth agreement of keyframes drawn from their own points."""
-    path = os.path.join(cell, "truth", "consistency_images", "summary.json")
+    path = check_file(cell, "summary.json")
     try:
         with open(path) as f:
             value = json.load(f)["self_check"]["depth_agreement_median"]
@@ -100,7 +106,8 @@ def main():
     print("|" + " --- |" * len(head))
     cells = 0
     for name in sorted(os.listdir(out)):
-        rows = cell_rows(os.path.join(out, name))
+        cell = os.path.join(out, name)
+        rows = cell_rows(cell)
         if not rows:
             continue
         cells += 1
@@ -110,7 +117,7 @@ def main():
         print(f"| {name} | {len(rows)} | {lowest(rows, 'ncc_sigmas')} | "
               f"{lowest(rows, 'depth_sigmas')} | {len(flagged)} / {sum(map(near, flagged))}"
               f"{at(flagged)} | "
-              f"{n_near}, {ncc_near} / {depth_near} | {self_check(os.path.join(out, name))} |")
+              f"{n_near}, {ncc_near} / {depth_near} | {self_check(cell)} |")
     if not cells:
         sys.exit(f"bench: {out}: no cell with a truth run")
 
