@@ -7,7 +7,8 @@
 //   - show the expected trajectories, and the expected number of points in its octree,
 //   - load and draw deeper octree levels when the camera moves in,
 //   - show a keyframe's panel (and its image, when the site has images) when one is clicked,
-//   - draw its tracks on the 2-D map (offline: the UTM grid) and the expected plots,
+//   - draw its tracks on the 2-D map (offline: the UTM grid) and the expected plots, and, with a
+//     tile URL set, the web map tiles under the tracks (checkWebTiles),
 //   - offer to colour the map by the image check's scores exactly when the site has them
 //     (--image-check), and colour it so.
 // Screenshots go to --shots. Prints one JSON line of figures; exits 1 on a failed check, 77 when
@@ -42,6 +43,87 @@ const check = (ok, what) => {
   if (!ok) failures.push(what);
   console.error(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
 };
+
+// The 2-D map over web map tiles from a URL the user sets, the tile server stood in by the test:
+// every tile one flat colour, served with CORS as public tile servers serve them. The tiles under
+// every track point must be requested, at one zoom, by the slippy-map formula (OpenStreetMap's,
+// not the page's code), at the deepest zoom whose extent of the tracks fits the 440 x 300 map
+// with a 20 px margin;
+// then drawn, with the tracks over them.
+const kTileRgb = [214, 160, 64];
+async function checkWebTiles(page, figures) {
+  const png = await page.evaluate((rgb) => {
+    const c = document.createElement('canvas');
+    c.width = c.height = 256;
+    const g = c.getContext('2d');
+    g.fillStyle = `rgb(${rgb.join(',')})`;
+    g.fillRect(0, 0, 256, 256);
+    return c.toDataURL('image/png').split(',')[1];
+  }, kTileRgb);
+  const requested = [];
+  await page.route('https://tiles.gvio.test/**', (route) => {
+    requested.push(route.request().url());
+    route.fulfill({ status: 200, contentType: 'image/png', body: Buffer.from(png, 'base64'),
+      headers: { 'Access-Control-Allow-Origin': '*' } });
+  });
+  await page.evaluate(() => {
+    const input = document.getElementById('map2d-canvas').nextElementSibling;
+    input.value = 'https://tiles.gvio.test/{z}/{x}/{y}.png';
+    input.dispatchEvent(new Event('change'));
+  });
+  // The tracks are drawn once every tile has answered: wait for pixels of neither kind.
+  const countPixels = (rgb) => {
+    const c = document.getElementById('map2d-canvas');
+    const px = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+    let tile = 0, other = 0;
+    for (let i = 0; i < px.length; i += 4) {
+      const d = Math.abs(px[i] - rgb[0]) + Math.abs(px[i + 1] - rgb[1]) + Math.abs(px[i + 2] - rgb[2]);
+      if (d <= 6) ++tile;
+      else ++other;
+    }
+    return { tile, other, all: px.length / 4 };
+  };
+  await page.evaluate(`window.gvioTestCountPixels = ${countPixels}`);
+  await page.waitForFunction((rgb) => window.gvioTestCountPixels(rgb).other > 200, kTileRgb, {
+    timeout: 20000,
+  });
+  const drawn = await page.evaluate((rgb) => window.gvioTestCountPixels(rgb), kTileRgb);
+  const tracks = await page.evaluate(() => window.gvioViewer.viewer.side2d.map.tracks.map((t) => t.lat_lon));
+  const tiles = requested.map((u) => u.match(/\/(\d+)\/(\d+)\/(\d+)\.png$/).slice(1).map(Number));
+  const zooms = [...new Set(tiles.map((t) => t[0]))];
+  check(zooms.length === 1, `the web tiles are requested at one zoom (${zooms})`);
+  const z = zooms[0];
+  // OpenStreetMap's slippy-map tile names, in world pixels at zoom z.
+  const world = (lat, lon, zoom) => {
+    const r = (lat * Math.PI) / 180, n = 256 * 2 ** zoom;
+    return [((lon + 180) / 360) * n, ((1 - Math.log(Math.tan(r) + 1 / Math.cos(r)) / Math.PI) / 2) * n];
+  };
+  const have = new Set(tiles.map((t) => `${t[1]}/${t[2]}`));
+  let missing = 0, total = 0;
+  const extent = (zoom) => {
+    const xs = [], ys = [];
+    for (const ll of tracks) for (let i = 0; i < ll.length; i += 2) {
+      const [x, y] = world(ll[i], ll[i + 1], zoom);
+      xs.push(x);
+      ys.push(y);
+    }
+    return [Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys)];
+  };
+  for (const ll of tracks) for (let i = 0; i < ll.length; i += 2) {
+    const [x, y] = world(ll[i], ll[i + 1], z);
+    ++total;
+    if (!have.has(`${Math.floor(x / 256)}/${Math.floor(y / 256)}`)) ++missing;
+  }
+  figures.web_tiles = { zoom: z, tiles: tiles.length, tile_share: +(drawn.tile / drawn.all).toFixed(3) };
+  check(total > 0 && missing === 0,
+    `web tiles: ${tiles.length} at zoom ${z}; ${missing} of ${total} track points on a tile not requested`);
+  const [w, h] = extent(z), [w1, h1] = extent(z + 1);
+  check(w < 400 && h < 260 && (z === 19 || w1 >= 400 || h1 >= 260),
+    `zoom ${z} fits the tracks (${w.toFixed(0)} x ${h.toFixed(0)} px; ${w1.toFixed(0)} x ${h1.toFixed(0)} at ${z + 1})`);
+  check(drawn.tile > 0.5 * drawn.all && drawn.other > 200,
+    `the tiles drawn under the tracks (${drawn.tile} tile pixels, ${drawn.other} others of ${drawn.all})`);
+  await page.screenshot({ path: `${shots}/map2d_tiles.png` });
+}
 
 const shots = resolve(args.shots);
 mkdirSync(shots, { recursive: true });
@@ -188,6 +270,7 @@ try {
     check(side.plots === Number(args.plots), `${side.plots} plots along the drive (expected ${args.plots})`);
   }
   await page.screenshot({ path: `${shots}/map2d.png` });
+  if (side.tracks > 0) await checkWebTiles(page, figures);
   const last = await page.evaluate(() => window.gvioViewer.stats());
   check(last.failed.length === 0, `no data file failed (${last.failed.join('; ')})`);
   check(errors.length === 0, `no console error (${errors.join(' | ')})`);
