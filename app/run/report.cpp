@@ -64,6 +64,8 @@ json datasetJson(const io::Dataset& ds) {
             {"gnss_fixes", ds.gnss.size()},
             {"groundtruth", ds.groundtruth ? json(ds.groundtruth_source) : json(nullptr)}};
   if (!ds.bag_topics.empty()) j["bag_topics"] = io::bagTopicsJson(ds);
+  // What the readers warned of (also on stderr), so a report read later still says it.
+  j["warnings"] = ds.warnings;
   return j;
 }
 

@@ -1,6 +1,8 @@
 // The fault matrix on ROS 2 bags (issue 60): a truncated .mcap is read up to the cut with a
 // warning; a chunk whose CRC fails, a missing split file, a topic of another type and a bag whose
 // tf tree does not reach its cameras each stop the run with one line naming the file (exit 2).
+#include <algorithm>
+
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -57,6 +59,10 @@ TEST(FaultRos2, TruncatedMcapIsReadUpToTheCut) {
   expectFiniteOutputs(c.out());
   expectNoTemporaries(c.out());
   const auto report = nlohmann::json::parse(readText(c.out() / "report.json"));
+  const auto& warnings = report["dataset"]["warnings"];
+  EXPECT_TRUE(std::any_of(warnings.begin(), warnings.end(), [&](const auto& w) {
+    return w.template get<std::string>().find(file.string() + ": cut short") == 0;
+  })) << warnings.dump();
   const auto& topics = report["dataset"]["bag_topics"];
   ASSERT_EQ(topics.size(), 4U);
   EXPECT_GT(topics[0]["messages"].get<int>(), 30);  // what was before the cut
