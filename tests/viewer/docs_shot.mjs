@@ -34,14 +34,8 @@ try {
     page.waitForFunction(() => window.gvioViewer?.stats().settled && window.gvioViewer.stats().frames > 0,
       null, { timeout: 60000 });
   await settle();
-  if (args.color) {
-    await page.evaluate((mode) => window.gvioViewer.setColorMode(mode), args.color);
-    // The select shows the mode too, as when a user picks it.
-    await page.evaluate((mode) => {
-      const select = document.getElementById('color-mode');
-      if (select) select.value = mode;
-    }, args.color);
-  }
+  // setColorMode also shows the mode in the panel's select, as when a user picks it.
+  if (args.color) await page.evaluate((mode) => window.gvioViewer.setColorMode(mode), args.color);
   if (args.keyframe !== undefined) {
     await page.evaluate(() => window.gvioViewer.showKeyframes(true));
     await page.waitForTimeout(200);

@@ -48,8 +48,7 @@ const check = (ok, what) => {
 // every tile one flat colour, served with CORS as public tile servers serve them. The tiles under
 // every track point must be requested, at one zoom, by the slippy-map formula (OpenStreetMap's,
 // not the page's code), at the deepest zoom whose extent of the tracks fits the 440 x 300 map
-// with a 20 px margin;
-// then drawn, with the tracks over them.
+// with a 20 px margin; then drawn, with the tracks over them.
 const kTileRgb = [214, 160, 64];
 async function checkWebTiles(page, figures) {
   const png = await page.evaluate((rgb) => {
@@ -88,7 +87,9 @@ async function checkWebTiles(page, figures) {
     timeout: 20000,
   });
   const drawn = await page.evaluate((rgb) => window.gvioTestCountPixels(rgb), kTileRgb);
-  const tracks = await page.evaluate(() => window.gvioViewer.viewer.side2d.map.tracks.map((t) => t.lat_lon));
+  // Every track point as [lat, lon].
+  const points = (await page.evaluate(() => window.gvioViewer.viewer.side2d.map.tracks.map((t) => t.lat_lon)))
+    .flatMap((ll) => Array.from({ length: ll.length / 2 }, (_, i) => [ll[2 * i], ll[2 * i + 1]]));
   const tiles = requested.map((u) => u.match(/\/(\d+)\/(\d+)\/(\d+)\.png$/).slice(1).map(Number));
   const zooms = [...new Set(tiles.map((t) => t[0]))];
   check(zooms.length === 1, `the web tiles are requested at one zoom (${zooms})`);
@@ -99,21 +100,16 @@ async function checkWebTiles(page, figures) {
     return [((lon + 180) / 360) * n, ((1 - Math.log(Math.tan(r) + 1 / Math.cos(r)) / Math.PI) / 2) * n];
   };
   const have = new Set(tiles.map((t) => `${t[1]}/${t[2]}`));
-  let missing = 0, total = 0;
   const extent = (zoom) => {
-    const xs = [], ys = [];
-    for (const ll of tracks) for (let i = 0; i < ll.length; i += 2) {
-      const [x, y] = world(ll[i], ll[i + 1], zoom);
-      xs.push(x);
-      ys.push(y);
-    }
-    return [Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys)];
+    const px = points.map(([lat, lon]) => world(lat, lon, zoom));
+    const span = (k) => Math.max(...px.map((p) => p[k])) - Math.min(...px.map((p) => p[k]));
+    return [span(0), span(1)];
   };
-  for (const ll of tracks) for (let i = 0; i < ll.length; i += 2) {
-    const [x, y] = world(ll[i], ll[i + 1], z);
-    ++total;
-    if (!have.has(`${Math.floor(x / 256)}/${Math.floor(y / 256)}`)) ++missing;
-  }
+  const total = points.length;
+  const missing = points.filter(([lat, lon]) => {
+    const [x, y] = world(lat, lon, z);
+    return !have.has(`${Math.floor(x / 256)}/${Math.floor(y / 256)}`);
+  }).length;
   figures.web_tiles = { zoom: z, tiles: tiles.length, tile_share: +(drawn.tile / drawn.all).toFixed(3) };
   check(total > 0 && missing === 0,
     `web tiles: ${tiles.length} at zoom ${z}; ${missing} of ${total} track points on a tile not requested`);
